@@ -1,0 +1,407 @@
+// fem_bench: measures every chapter on the same scene and mesh, in one process so that
+// the ratios between chapters hold while the machine's speed drifts. Prints the
+// per-phase table (median ms, allocations per step) and writes it as JSON.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+
+#include "chapters/06_custom_pcg/stepper.hpp"
+#include "chapters/registry.hpp"
+#include "common/alloc_counter.hpp"
+#include "common/build_info.hpp"
+#include "common/cli.hpp"
+
+namespace {
+
+using namespace fem;
+
+constexpr std::array<const char*, 6> kPhases = {"forces", "dfdx", "compose", "constraints",
+                                                "solve", "step"};
+
+std::array<PhaseCost, 6> phases(const StepProfile& p) {
+  return {p.forces, p.dfdx, p.compose, p.constraints, p.solve, p.step};
+}
+
+// Order statistics of a sample: min, first quartile, median, third quartile, max.
+struct Spread {
+  double min, q1, median, q3, max;
+};
+
+Spread spread(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const auto at = [&v](double q) {  // linear interpolation between order statistics
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const auto lo = static_cast<std::size_t>(pos);
+    const std::size_t hi = std::min(lo + 1, v.size() - 1);
+    return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+  };
+  return {v.front(), at(0.25), at(0.5), at(0.75), v.back()};
+}
+
+struct ChapterResult {
+  std::string chapter;
+  std::array<Spread, 6> ms;  // per phase, milliseconds
+  double allocations_per_step;  // median over the measured steps
+  std::array<long long, 6> phase_allocations;  // per phase, the last measured step
+  long long allocations_max;
+  double cg_iterations;  // median
+  double relative_residual;  // last step
+  int not_converged_steps;
+};
+
+ChapterResult run_chapter(const ChapterInfo& chapter, const Scene& scene,
+                          const SolverSettings& solver, int warmup, int steps) {
+  auto stepper = chapter.make(scene, solver);
+  State state = rest_state(scene);
+  std::array<std::vector<double>, 6> seconds;
+  std::vector<double> allocations, iterations;
+  ChapterResult r{chapter.id, {}, 0.0, {}, 0, 0.0, 0.0, 0};
+  for (int k = 0; k < warmup + steps; ++k) {
+    alloc::Scope counter;
+    stepper->step(state);
+    const long long allocs = counter.allocations();
+    if (!state.x.allFinite())
+      throw std::runtime_error(chapter.id + ": the simulation diverged at step " +
+                               std::to_string(k + 1) + " (non-finite positions)");
+    if (k < warmup) continue;
+    const StepProfile& p = stepper->profile();
+    const auto s = phases(p);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      seconds[i].push_back(1e3 * s[i].seconds);
+      r.phase_allocations[i] = s[i].allocations;  // deterministic: the last step's
+    }
+    allocations.push_back(static_cast<double>(allocs));
+    r.allocations_max = std::max(r.allocations_max, allocs);
+    iterations.push_back(p.cg_iterations);
+    r.relative_residual = p.relative_residual;
+    r.not_converged_steps += p.converged ? 0 : 1;
+  }
+  for (std::size_t i = 0; i < seconds.size(); ++i) r.ms[i] = spread(seconds[i]);
+  r.allocations_per_step = spread(allocations).median;
+  r.cg_iterations = spread(iterations).median;
+  return r;
+}
+
+// The poster's solve table, on the same sequence of systems: the filtered systems of a
+// run of chapter 06 on the scene. Each solver solves every system from the same inputs;
+// "guess" solvers start from the previous system's solution.
+struct SolverResult {
+  std::string name;
+  double median_ms = 0.0, iterations = 0.0, allocations_per_solve = 0.0;
+};
+
+std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& settings,
+                                      int warmup, int steps) {
+  using SparseMatrix = Eigen::SparseMatrix<double>;
+  struct Samples {
+    std::vector<double> ms, iterations, allocations;
+  };
+  const std::vector<std::string> names = {"eigen_cg",       "eigen_cg_guess", "pcg_ch06",
+                                          "eigen_cg_full",  "eigen_cg_ichol", "eigen_ldlt"};
+  std::vector<Samples> samples(names.size());
+  ch06::CustomPcgStepper stepper(scene, settings);
+  State state = rest_state(scene);
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x;
+  ch06::PcgWorkspace work;
+  Eigen::ConjugateGradient<SparseMatrix> cg;
+  Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper> cg_full;
+  Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
+                           Eigen::IncompleteCholesky<double>> cg_ichol;
+  Eigen::SimplicialLDLT<SparseMatrix> ldlt;
+  const auto configure = [&settings](auto& solver) {
+    solver.setTolerance(settings.tolerance);  // Eigen's default is machine epsilon
+    solver.setMaxIterations(settings.max_iterations);
+  };
+  configure(cg);
+  configure(cg_full);
+  configure(cg_ichol);
+  std::vector<int> offsets;
+  for (int k = 0; k < warmup + steps; ++k) {
+    stepper.step(state);
+    const SparseMatrix& A = stepper.system_matrix();
+    const Eigen::VectorXd& b = stepper.system_rhs();
+    if (offsets.empty()) offsets = ch06::diagonal_offsets(A);
+    const auto measure = [&](std::size_t i, const std::function<double()>& solve) {
+      alloc::Scope scope;
+      const auto start = std::chrono::steady_clock::now();
+      const double iterations = solve();
+      const double ms =
+          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const long long allocations = scope.allocations();
+      if (k < warmup) return;
+      samples[i].ms.push_back(ms);
+      samples[i].iterations.push_back(iterations);
+      samples[i].allocations.push_back(static_cast<double>(allocations));
+    };
+    measure(0, [&] {
+      cg.compute(A);
+      x = cg.solve(b);
+      return static_cast<double>(cg.iterations());
+    });
+    measure(1, [&] {
+      cg.compute(A);
+      x = cg.solveWithGuess(b, previous);
+      return static_cast<double>(cg.iterations());
+    });
+    measure(2, [&] {
+      x = previous;
+      return static_cast<double>(
+          ch06::pcg_solve(A, b, scene.constraints, offsets, settings, work, x).iterations);
+    });
+    previous = x;  // the next system's guess: this one's solution
+    measure(3, [&] {
+      cg_full.compute(A);
+      x = cg_full.solve(b);
+      return static_cast<double>(cg_full.iterations());
+    });
+    measure(4, [&] {
+      cg_ichol.compute(A);
+      x = cg_ichol.solve(b);
+      return static_cast<double>(cg_ichol.iterations());
+    });
+    measure(5, [&] {
+      ldlt.compute(A);  // symbolic analysis and numeric factorization, every step
+      x = ldlt.solve(b);
+      return 0.0;
+    });
+  }
+  std::vector<SolverResult> out;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out.push_back({names[i], spread(samples[i].ms).median, spread(samples[i].iterations).median,
+                   spread(samples[i].allocations).median});
+  return out;
+}
+
+void print_solvers(const std::vector<SolverResult>& solvers) {
+  std::cout << "\nsolve table (the filtered systems of chapter 06's run; same tolerance)\n"
+            << std::left << std::setw(18) << "solver" << std::right << std::setw(12) << "median ms"
+            << std::setw(12) << "iterations" << std::setw(14) << "allocs/solve" << std::setw(14)
+            << "vs eigen_cg\n";
+  for (const auto& s : solvers)
+    std::cout << std::left << std::setw(18) << s.name << std::right << std::fixed
+              << std::setprecision(3) << std::setw(12) << s.median_ms << std::setprecision(0)
+              << std::setw(12) << s.iterations << std::setw(14) << s.allocations_per_solve
+              << std::setprecision(2) << std::setw(12) << solvers.front().median_ms / s.median_ms
+              << "x" << std::defaultfloat << "\n";
+  std::cout << "(iterations: Eigen counts the products of full iterations, the last one excluded;"
+               " pcg_ch06 counts every product)\n";
+}
+
+std::string git_commit() {
+  const std::string cmd = "git -C '" + source_dir() + "' rev-parse --short HEAD 2>/dev/null";
+  std::string out;
+  if (FILE* pipe = popen(cmd.c_str(), "r")) {
+    char buf[64];
+    while (fgets(buf, sizeof buf, pipe)) out += buf;
+    pclose(pipe);
+  }
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out.empty() ? "unknown" : out;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string spread_json(const std::array<Spread, 6>& ms, double Spread::*field) {
+  std::ostringstream out;
+  out << "{";
+  for (std::size_t i = 0; i < kPhases.size(); ++i)
+    out << (i ? ", " : "") << json_string(kPhases[i]) << ": " << ms[i].*field;
+  out << "}";
+  return out.str();
+}
+
+std::string allocations_json(const std::array<long long, 6>& a) {
+  std::ostringstream out;
+  out << "{";
+  for (std::size_t i = 0; i < kPhases.size(); ++i)
+    out << (i ? ", " : "") << json_string(kPhases[i]) << ": " << a[i];
+  out << "}";
+  return out.str();
+}
+
+void write_json(const std::string& path, const Scene& scene, const SolverSettings& solver,
+                int warmup, int steps, const std::vector<ChapterResult>& results,
+                const std::vector<SolverResult>& solvers) {
+  namespace fs = std::filesystem;
+  if (const fs::path dir = fs::path(path).parent_path(); !dir.empty()) fs::create_directories(dir);
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  const BuildInfo b = build_info();
+  out << std::setprecision(10);
+  out << "{\n  \"schema_version\": 1,\n";
+  out << "  \"mesh\": {\"file\": " << json_string(fs::path(scene.mesh.file).filename().string())
+      << ", \"nodes\": " << scene.mesh.num_nodes() << ", \"tets\": " << scene.mesh.num_tets()
+      << "},\n";
+  out << "  \"scene\": " << json_string(scene.name) << ",\n";
+  out << "  \"steps\": " << steps << ",\n  \"warmup_steps\": " << warmup << ",\n";
+  out << "  \"dt\": " << scene.dt << ",\n";
+  out << "  \"material\": {\"E\": " << scene.material.youngs_modulus
+      << ", \"nu\": " << scene.material.poisson_ratio << ", \"rho\": " << scene.material.density
+      << ", \"alpha\": " << scene.damping.alpha << ", \"beta\": " << scene.damping.beta << "},\n";
+  out << "  \"cg_tolerance\": " << solver.tolerance
+      << ",\n  \"cg_max_iterations\": " << solver.max_iterations << ",\n";
+  out << "  \"build\": {\"compiler\": " << json_string(b.compiler)
+      << ", \"flags\": " << json_string(b.flags) << ", \"build_type\": " << json_string(b.build_type)
+      << ", \"eigen\": " << json_string(b.eigen) << "},\n";
+  out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
+      << ", \"threads\": " << hardware_threads() << "},\n";
+  out << "  \"commit\": " << json_string(git_commit()) << ",\n";
+  out << "  \"chapters\": [\n";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const ChapterResult& r = results[i];
+    out << "    {\"chapter\": " << json_string(r.chapter) << ",\n"
+        << "     \"median_ms\": " << spread_json(r.ms, &Spread::median) << ",\n"
+        << "     \"min_ms\": " << spread_json(r.ms, &Spread::min) << ",\n"
+        << "     \"q1_ms\": " << spread_json(r.ms, &Spread::q1) << ",\n"
+        << "     \"q3_ms\": " << spread_json(r.ms, &Spread::q3) << ",\n"
+        << "     \"max_ms\": " << spread_json(r.ms, &Spread::max) << ",\n"
+        << "     \"allocations\": " << allocations_json(r.phase_allocations) << ",\n"
+        << "     \"allocations_per_step\": " << r.allocations_per_step
+        << ", \"allocations_max\": " << r.allocations_max
+        << ", \"cg_iterations\": " << r.cg_iterations
+        << ", \"relative_residual\": " << r.relative_residual
+        << ", \"not_converged_steps\": " << r.not_converged_steps << "}"
+        << (i + 1 < results.size() ? "," : "") << "\n";
+  }
+  out << "  ]";
+  if (!solvers.empty()) {
+    out << ",\n  \"solvers\": [\n";
+    for (std::size_t i = 0; i < solvers.size(); ++i)
+      out << "    {\"name\": " << json_string(solvers[i].name)
+          << ", \"median_ms\": " << solvers[i].median_ms
+          << ", \"iterations\": " << solvers[i].iterations
+          << ", \"allocations_per_solve\": " << solvers[i].allocations_per_solve << "}"
+          << (i + 1 < solvers.size() ? "," : "") << "\n";
+    out << "  ]";
+  }
+  out << "\n}\n";
+}
+
+void print_table(const std::vector<ChapterResult>& results) {
+  std::cout << "\nmedian ms per step (forces = rotations + element forces, the same code in every chapter)\n";
+  std::cout << std::left << std::setw(26) << "chapter" << std::right;
+  for (const char* p : kPhases) std::cout << std::setw(12) << p;
+  std::cout << std::setw(13) << "allocs/step" << std::setw(8) << "CG it" << std::setw(11) << "rel.res.\n";
+  for (const auto& r : results) {
+    std::cout << std::left << std::setw(26) << r.chapter << std::right << std::fixed
+              << std::setprecision(3);
+    for (const auto& s : r.ms) std::cout << std::setw(12) << s.median;
+    std::cout << std::setw(13) << std::setprecision(0) << r.allocations_per_step << std::setw(8)
+              << r.cg_iterations << std::setw(10) << std::scientific << std::setprecision(1)
+              << r.relative_residual << std::defaultfloat << "\n";
+  }
+  std::cout << "\nheap allocations per phase (last measured step)\n";
+  for (const auto& r : results) {
+    std::cout << std::left << std::setw(26) << r.chapter << std::right;
+    for (const long long a : r.phase_allocations) std::cout << std::setw(12) << a;
+    std::cout << "\n";
+  }
+  if (results.size() > 1) {
+    std::cout << "\nspeedup over " << results.front().chapter << " (median ratio)\n";
+    for (const auto& r : results) {
+      std::cout << std::left << std::setw(26) << r.chapter << std::right << std::fixed
+                << std::setprecision(2);
+      for (std::size_t i = 0; i < r.ms.size(); ++i)
+        std::cout << std::setw(11) << results.front().ms[i].median / r.ms[i].median << "x";
+      std::cout << std::defaultfloat << "\n";
+    }
+  }
+}
+
+std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
+  std::vector<const ChapterInfo*> out;
+  if (list == "all") {
+    for (const auto& c : chapters()) out.push_back(&c);
+    return out;
+  }
+  std::stringstream in(list);
+  std::string name;
+  while (std::getline(in, name, ',')) {
+    try {
+      out.push_back(&find_chapter(name));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  }
+  if (out.empty()) throw UsageError("--chapters is empty");
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ArgParser args("fem_bench",
+                 "Benchmarks chapters on one scene: per-phase median ms, allocations per step,\n"
+                 "CG iterations; prints a table and writes JSON (schema in README.md).");
+  add_scene_options(args, "meshes/plate_poster.msh");
+  add_solver_options(args);
+  args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
+  args.option("steps", "N", "measured steps per chapter, > 0", "100");
+  args.option("warmup", "N", "unmeasured steps first, >= 0", "10");
+  args.option("json", "FILE", "where to write the results ('' for nowhere)", "results/bench.json");
+  args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT)");
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    const auto selected = parse_chapters(args.get("chapters"));
+    const int steps = args.get_int("steps"), warmup = args.get_int("warmup");
+    if (steps <= 0) throw UsageError("--steps must be positive");
+    if (warmup < 0) throw UsageError("--warmup must be >= 0");
+    const SolverSettings solver = solver_from_args(args);
+    const Scene scene = scene_from_args(args);
+    const BuildInfo b = build_info();
+    std::cout << "fem_bench: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
+              << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), dt "
+              << scene.dt << " s, " << warmup << " warm-up + " << steps << " measured steps, CG tol "
+              << solver.tolerance << "\n"
+              << "build: " << b.compiler << ", " << b.flags << ", Eigen " << b.eigen << "; CPU "
+              << cpu_model() << "\n";
+    if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
+
+    std::vector<ChapterResult> results;
+    for (const ChapterInfo* c : selected) {
+      std::cout << "  running " << c->id << " ..." << std::flush;
+      results.push_back(run_chapter(*c, scene, solver, warmup, steps));
+      std::cout << " step " << std::fixed << std::setprecision(3) << results.back().ms[5].median
+                << " ms" << std::defaultfloat << "\n";
+      if (results.back().not_converged_steps > 0)
+        std::cout << "    warning: " << results.back().not_converged_steps
+                  << " steps stopped at the CG iteration cap\n";
+    }
+    print_table(results);
+    std::vector<SolverResult> solvers;
+    if (!args.has_flag("no-solvers")) {
+      std::cout << "\n  running the solve table ..." << std::flush;
+      solvers = run_solvers(scene, solver, warmup, steps);
+      std::cout << " done\n";
+      print_solvers(solvers);
+    }
+    if (const std::string& path = args.get("json"); !path.empty()) {
+      write_json(path, scene, solver, warmup, steps, results, solvers);
+      std::cout << "\nwrote " << path << "\n";
+    }
+  } catch (const UsageError& e) {
+    std::cerr << "fem_bench: " << e.what() << " (see fem_bench --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "fem_bench: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

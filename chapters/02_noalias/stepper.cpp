@@ -1,0 +1,151 @@
+// Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+// with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
+//   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
+// Chapter 02 changes only the vector statements: none of them allocates any more.
+#include "chapters/02_noalias/stepper.hpp"
+
+#include <iostream>
+
+namespace fem::ch02 {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+using Triplet = Eigen::Triplet<double>;
+
+NoAliasStepper::NoAliasStepper(const Scene& scene, const SolverSettings& settings)
+    : scene_(scene), model_(scene), settings_(settings) {
+  const int n = model_.dofs;
+  rotations_.resize(model_.tets.size());
+  f_.resize(n);
+
+  // The pattern of df/dx is the mesh connectivity: a 3x3 block per pair of nodes that
+  // share a tetrahedron. Allocated once here; each step only overwrites the values.
+  std::vector<Triplet> pattern;
+  const auto adjacency = node_adjacency(scene.mesh);
+  for (int i = 0; i < model_.num_nodes; ++i)
+    for (const int j : adjacency[i])
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) pattern.emplace_back(3 * i + r, 3 * j + c, 0.0);
+  dfdx_.resize(n, n);
+  dfdx_.setFromTriplets(pattern.begin(), pattern.end());
+
+  std::vector<Triplet> mass;
+  for (int k = 0; k < n; ++k) mass.emplace_back(k, k, model_.lumped_mass[k]);
+  M_.resize(n, n);
+  M_.setFromTriplets(mass.begin(), mass.end());
+
+  S_.resize(n, n);
+  identity_.resize(n, n);
+  identity_.setIdentity();
+  constrained_.assign(model_.num_nodes, false);
+
+  f_ext_.resize(n);
+  for (const auto& e : scene.external_forces)
+    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
+}
+
+void NoAliasStepper::step(State& state) {
+  PhaseTimer total(profile_.step);
+  {
+    PhaseTimer t(profile_.forces);
+    compute_rotations_and_forces(model_, state.x, rotations_, f_);
+  }
+  {
+    PhaseTimer t(profile_.dfdx);
+    build_dfdx();
+  }
+  {
+    PhaseTimer t(profile_.compose);
+    compose_system(state);
+  }
+  {
+    PhaseTimer t(profile_.constraints);
+    apply_constraints(state);
+  }
+  {
+    PhaseTimer t(profile_.solve);
+    solve();
+  }
+  state.v += dv_;
+  state.x += scene_.dt * state.v;
+}
+
+void NoAliasStepper::build_dfdx() {
+  dfdx_.coeffs().setZero();  // keeps the pattern (setZero() on the matrix would drop it)
+  for (std::size_t e = 0; e < model_.tets.size(); ++e) {
+    const Eigen::Vector4i& t = model_.tets[e];
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const Eigen::Matrix3d block = dfdx_block(model_.rest[e], rotations_[e], a, b);
+        // coeffRef finds each entry by a binary search in its column: 144 searches
+        // per element, every step.
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) dfdx_.coeffRef(3 * t[a] + r, 3 * t[b] + c) += block(r, c);
+      }
+    }
+  }
+}
+
+void NoAliasStepper::compose_system(const State& state) {
+  const double h = scene_.dt;
+  const double alpha = scene_.damping.alpha, beta = scene_.damping.beta;
+  // The matrices are still sparse expressions (chapter 04 removes them).
+  const SparseMatrix dfdv = -alpha * M_ + beta * dfdx_;
+  A_ = M_ - h * dfdv - h * h * dfdx_;
+  // b = h (f + df/dv v + h df/dx v) = h (f - alpha M v) + h df/dx ((h + beta) v):
+  // with Rayleigh damping the two products collapse into one sparse product with a
+  // dense vector, held in a reused temporary. `b = ... (dfdx * v)` would evaluate the
+  // product into a hidden temporary first, because Eigen assumes b could appear on the
+  // right; noalias() promises it does not, and the product is accumulated into b.
+  // (noalias() only matters for products: coefficient-wise expressions never allocate.)
+  tmp_ = (h + beta) * state.v;
+  b_.noalias() = h * (dfdx_ * tmp_);
+  b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
+  b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary
+}
+
+void NoAliasStepper::apply_constraints(const State& state) {
+  const int n = model_.dofs;
+  // S is identity on free nodes and the filter S_i on constrained ones; z carries the
+  // constrained part of the target velocity: z_i = (I - S_i)(v_target - v_i).
+  // The triplet list and the flags keep their capacity from the previous step.
+  std::fill(constrained_.begin(), constrained_.end(), false);
+  s_triplets_.clear();
+  z_.setZero(n);
+  for (const auto& c : scene_.constraints) {
+    constrained_[c.node] = true;
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k)
+        if (c.filter(r, k) != 0.0)
+          s_triplets_.emplace_back(3 * c.node + r, 3 * c.node + k, c.filter(r, k));
+    z_.segment<3>(3 * c.node).noalias() = (Eigen::Matrix3d::Identity() - c.filter) *
+                                          (c.target_velocity - state.v.segment<3>(3 * c.node));
+  }
+  for (int i = 0; i < model_.num_nodes; ++i)
+    if (!constrained_[i])
+      for (int r = 0; r < 3; ++r) s_triplets_.emplace_back(3 * i + r, 3 * i + r, 1.0);
+  // Building S and the sparse products still allocate (chapter 05 removes S).
+  S_.setFromTriplets(s_triplets_.begin(), s_triplets_.end());
+  const SparseMatrix S_transpose = S_.transpose();  // S^T is row-major: store it to mix it
+  filtered_A_ = S_ * A_ * S_transpose + (identity_ - S_);
+  // S (b - A z) as written evaluates A z into a temporary, then b - A z into another,
+  // before the product with S: reuse tmp_ and give every product its own noalias().
+  tmp_ = b_;
+  tmp_.noalias() -= A_ * z_;
+  filtered_b_.noalias() = S_ * tmp_;
+}
+
+void NoAliasStepper::solve() {
+  cg_.setTolerance(settings_.tolerance);  // Eigen's default is machine epsilon
+  cg_.setMaxIterations(settings_.max_iterations);
+  cg_.compute(filtered_A_);
+  // `cg_.solve(b) + z` would evaluate the solve into a temporary before the sum.
+  dv_ = cg_.solve(filtered_b_);
+  dv_ += z_;
+  profile_.cg_iterations = static_cast<int>(cg_.iterations());
+  profile_.relative_residual = cg_.error();
+  profile_.converged = cg_.info() == Eigen::Success;
+  report_if_not_converged(profile_, settings_, "02_noalias", warned_not_converged_);
+}
+
+}  // namespace fem::ch02

@@ -1,0 +1,60 @@
+// Chapter 02: no hidden temporaries. The step of chapter 01 with every vector statement
+// rewritten so that Eigen's assignment allocates nothing: noalias() where the destination
+// is not on the right-hand side, and work vectors sized once and reused across steps.
+#pragma once
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "common/model.hpp"
+#include "common/stepper.hpp"
+
+namespace fem::ch02 {
+
+class NoAliasStepper final : public Stepper {
+ public:
+  NoAliasStepper(const Scene& scene, const SolverSettings& settings);
+  void step(State& state) override;
+  const StepProfile& profile() const override { return profile_; }
+
+  // The last step's filtered system S A S^T + I - S and right-hand side S (b - A z):
+  // the reference that later chapters' in-place constraints are checked against.
+  const Eigen::SparseMatrix<double>& system_matrix() const { return filtered_A_; }
+  const Eigen::VectorXd& system_rhs() const { return filtered_b_; }
+  const Eigen::SparseMatrix<double>& dfdx() const { return dfdx_; }
+
+ private:
+  void build_dfdx();
+  void compose_system(const State& state);
+  void apply_constraints(const State& state);
+  void solve();
+
+  Scene scene_;
+  Model model_;
+  SolverSettings settings_;
+  StepProfile profile_;
+  bool warned_not_converged_ = false;
+
+  std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
+  Eigen::VectorXd f_;                       // elastic forces + gravity
+  Eigen::SparseVector<double> f_ext_;       // the sparse interaction forces
+  Eigen::SparseMatrix<double> M_;           // lumped mass, a diagonal sparse matrix
+  Eigen::SparseMatrix<double> dfdx_;        // pattern of the mesh connectivity, allocated once
+  Eigen::SparseMatrix<double> A_;           // M - h df/dv - h^2 df/dx
+  Eigen::VectorXd b_;                       // h (f + h df/dx v)
+  Eigen::SparseMatrix<double> S_;           // the constraint filter, 3x3 blocks S_i on the diagonal
+  Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
+  Eigen::SparseMatrix<double> filtered_A_;  // S A S^T + I - S
+  Eigen::VectorXd filtered_b_;              // S (b - A z)
+  Eigen::VectorXd dv_;
+
+  // Reused across steps: sized on the first step, never reallocated afterwards.
+  Eigen::VectorXd tmp_;                 // (h + beta) v, then b - A z
+  std::vector<Eigen::Triplet<double>> s_triplets_;
+  std::vector<bool> constrained_;
+  Eigen::SparseMatrix<double> identity_;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>> cg_;  // default: Lower, Jacobi
+};
+
+}  // namespace fem::ch02

@@ -1,0 +1,177 @@
+#include "common/cli.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "common/build_info.hpp"
+
+namespace fem {
+namespace {
+
+std::string format_number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+}  // namespace
+
+ArgParser::ArgParser(std::string program, std::string summary)
+    : program_(std::move(program)), summary_(std::move(summary)) {}
+
+void ArgParser::option(const std::string& name, const std::string& value_name,
+                       const std::string& help, const std::string& default_value) {
+  order_.push_back(name);
+  options_[name] = {value_name, help, default_value, false, false};
+}
+
+void ArgParser::flag(const std::string& name, const std::string& help) {
+  order_.push_back(name);
+  options_[name] = {"", help, "", true, false};
+}
+
+bool ArgParser::parse(int argc, const char* const* argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << help();
+      return false;
+    }
+    std::string value;
+    bool has_inline_value = false;
+    if (const auto eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+      value = arg.substr(eq + 1);
+      arg = arg.substr(0, eq);
+      has_inline_value = true;
+    }
+    if (arg.rfind("--", 0) != 0) throw UsageError("unexpected argument '" + arg + "'");
+    const auto it = options_.find(arg.substr(2));
+    if (it == options_.end()) throw UsageError("unknown option '" + arg + "'");
+    Option& opt = it->second;
+    opt.set = true;
+    if (opt.is_flag) {
+      if (has_inline_value) throw UsageError("option '" + arg + "' takes no value");
+      continue;
+    }
+    if (!has_inline_value) {
+      if (i + 1 >= argc) throw UsageError("option '" + arg + "' needs a value");
+      value = argv[++i];
+    }
+    opt.value = value;
+  }
+  return true;
+}
+
+const std::string& ArgParser::get(const std::string& name) const { return options_.at(name).value; }
+
+double ArgParser::get_double(const std::string& name) const {
+  const std::string& s = get(name);
+  std::size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != s.size() || !std::isfinite(v))
+    throw UsageError("--" + name + " expects a finite number, got '" + s + "'");
+  return v;
+}
+
+int ArgParser::get_int(const std::string& name) const {
+  const std::string& s = get(name);
+  std::size_t used = 0;
+  int v = 0;
+  try {
+    v = std::stoi(s, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != s.size()) throw UsageError("--" + name + " expects an integer, got '" + s + "'");
+  return v;
+}
+
+bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
+
+std::string ArgParser::help() const {
+  std::ostringstream out;
+  out << "usage: " << program_ << " [options]\n\n" << summary_ << "\n\noptions:\n";
+  for (const auto& name : order_) {
+    const Option& o = options_.at(name);
+    std::string left = "  --" + name + (o.is_flag ? "" : " " + o.value_name);
+    out << left << std::string(left.size() < 26 ? 26 - left.size() : 1, ' ') << o.help;
+    if (!o.is_flag && !o.value.empty()) out << " (default: " << o.value << ")";
+    out << "\n";
+  }
+  out << "  --help                  print this help and exit\n";
+  return out.str();
+}
+
+void add_scene_options(ArgParser& args, const std::string& default_mesh) {
+  const Material m;
+  const RayleighDamping d;
+  const Scene s;
+  args.option("scene", "NAME", "built-in scene: cantilever or sliding", "cantilever");
+  args.option("mesh", "FILE", "gmsh .msh file with linear tetrahedra", default_mesh);
+  args.option("E", "PA", "Young's modulus, > 0", format_number(m.youngs_modulus));
+  args.option("nu", "RATIO", "Poisson's ratio, in (-1, 0.5)", format_number(m.poisson_ratio));
+  args.option("rho", "KG_M3", "density, > 0", format_number(m.density));
+  args.option("dt", "SECONDS", "time step, > 0", format_number(s.dt));
+  args.option("alpha", "1/S", "Rayleigh mass damping, >= 0", format_number(d.alpha));
+  args.option("beta", "S", "Rayleigh stiffness damping, >= 0", format_number(d.beta));
+}
+
+std::string resolve_mesh_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (fs::path(path).is_relative() && !fs::exists(path) && fs::exists(fs::path(source_dir()) / path))
+    return (fs::path(source_dir()) / path).string();
+  return path;
+}
+
+Scene scene_from_args(const ArgParser& args) {
+  Material m;
+  m.youngs_modulus = args.get_double("E");
+  m.poisson_ratio = args.get_double("nu");
+  m.density = args.get_double("rho");
+  const double dt = args.get_double("dt");
+  const double alpha = args.get_double("alpha"), beta = args.get_double("beta");
+  // Check the numbers before loading a mesh, so a typo fails at once.
+  Scene probe;
+  probe.material = m;
+  probe.dt = dt;
+  probe.damping = {alpha, beta};
+  try {
+    validate(probe);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const std::string& name = args.get("scene");
+  bool known = false;
+  for (const auto& s : scene_names()) known = known || s == name;
+  if (!known) throw UsageError("unknown scene '" + name + "' (known: cantilever, sliding)");
+
+  Scene scene = make_scene(name, load_mesh(resolve_mesh_path(args.get("mesh"))), m);
+  scene.dt = dt;
+  scene.damping = {alpha, beta};
+  validate(scene);
+  return scene;
+}
+
+void add_solver_options(ArgParser& args) {
+  const SolverSettings s;
+  args.option("tol", "REL", "CG relative residual tolerance, in (0, 1)", format_number(s.tolerance));
+  args.option("max-iters", "N", "CG iteration cap, > 0", std::to_string(s.max_iterations));
+}
+
+SolverSettings solver_from_args(const ArgParser& args) {
+  SolverSettings s;
+  s.tolerance = args.get_double("tol");
+  s.max_iterations = args.get_int("max-iters");
+  if (!(s.tolerance > 0.0 && s.tolerance < 1.0)) throw UsageError("--tol must lie in (0, 1)");
+  if (s.max_iterations <= 0) throw UsageError("--max-iters must be positive");
+  return s;
+}
+
+}  // namespace fem

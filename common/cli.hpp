@@ -1,0 +1,59 @@
+// A small command-line parser shared by the apps: "--name value" options with
+// defaults, flags, --help, and clear errors for anything else.
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "common/stepper.hpp"
+
+namespace fem {
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class ArgParser {
+ public:
+  ArgParser(std::string program, std::string summary);
+  void option(const std::string& name, const std::string& value_name, const std::string& help,
+              const std::string& default_value);
+  void flag(const std::string& name, const std::string& help);
+
+  // Returns false when --help was asked for (the help is printed); throws UsageError
+  // for an unknown option or a missing value.
+  bool parse(int argc, const char* const* argv);
+
+  const std::string& get(const std::string& name) const;
+  double get_double(const std::string& name) const;  // throws UsageError if not a number
+  int get_int(const std::string& name) const;        // throws UsageError if not an integer
+  bool has_flag(const std::string& name) const;
+  std::string help() const;
+
+ private:
+  struct Option {
+    std::string value_name, help, value;
+    bool is_flag = false;
+    bool set = false;
+  };
+  std::string program_, summary_;
+  std::vector<std::string> order_;
+  std::map<std::string, Option> options_;
+};
+
+// The options every app shares: --scene --mesh --E --nu --rho --dt --alpha --beta.
+void add_scene_options(ArgParser& args, const std::string& default_mesh);
+// Builds and validates the scene they describe; throws UsageError with the reason.
+Scene scene_from_args(const ArgParser& args);
+
+// --tol and --max-iters.
+void add_solver_options(ArgParser& args);
+SolverSettings solver_from_args(const ArgParser& args);
+
+// A relative mesh path is looked up from the working directory, then from the repository.
+std::string resolve_mesh_path(const std::string& path);
+
+}  // namespace fem

@@ -1,0 +1,181 @@
+#include "common/mesh.hpp"
+
+#include <gmsh.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <unordered_map>
+
+namespace fem {
+namespace {
+
+[[noreturn]] void fail(const std::string& file, const std::string& problem) {
+  throw MeshError("mesh '" + file + "': " + problem);
+}
+
+double signed_volume6(const Eigen::Matrix3Xd& X, const Eigen::Vector4i& t) {
+  Eigen::Matrix3d Dm;
+  for (int i = 0; i < 3; ++i) Dm.col(i) = X.col(t[i + 1]) - X.col(t[0]);
+  return Dm.determinant();
+}
+
+double longest_edge(const Eigen::Matrix3Xd& X, const Eigen::Vector4i& t) {
+  double l = 0.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) l = std::max(l, (X.col(t[i]) - X.col(t[j])).norm());
+  return l;
+}
+
+// gmsh keeps global state: initialize once, clear before each file.
+std::mutex& gmsh_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+bool gmsh_initialized = false;
+
+void ensure_gmsh_initialized() {
+  if (gmsh_initialized) return;
+  gmsh::initialize(0, nullptr, /*readConfigFiles=*/false, /*run=*/false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("General.Verbosity", 0);
+  gmsh_initialized = true;
+}
+
+// After a parse error gmsh stays "busy" and answers nothing more: start it afresh.
+void reset_gmsh() {
+  gmsh::finalize();
+  gmsh_initialized = false;
+}
+
+}  // namespace
+
+TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const std::string& name) {
+  if (tets.empty()) fail(name, "no tetrahedra (a file whose only physical group is a surface saves none)");
+  if (!X.allFinite()) {
+    Eigen::Index bad = 0;
+    while (X.col(bad).allFinite()) ++bad;
+    fail(name, "node " + std::to_string(bad) + " has a NaN or infinite coordinate");
+  }
+  for (const auto& t : tets)
+    for (int i = 0; i < 4; ++i)
+      if (t[i] < 0 || t[i] >= X.cols()) fail(name, "a tetrahedron refers to a missing node");
+
+  TetMesh mesh;
+  mesh.file = name;
+  // Drop unused nodes and renumber densely.
+  std::vector<int> new_index(static_cast<std::size_t>(X.cols()), -1);
+  int used = 0;
+  for (const auto& t : tets)
+    for (int i = 0; i < 4; ++i)
+      if (new_index[t[i]] < 0) new_index[t[i]] = 0;
+  for (auto& n : new_index)
+    if (n == 0) n = used++;
+  mesh.dropped_nodes = static_cast<int>(X.cols()) - used;
+  mesh.X.resize(3, used);
+  for (Eigen::Index i = 0; i < X.cols(); ++i)
+    if (new_index[i] >= 0) mesh.X.col(new_index[i]) = X.col(i);
+  for (auto& t : tets)
+    for (int i = 0; i < 4; ++i) t[i] = new_index[t[i]];
+
+  for (std::size_t e = 0; e < tets.size(); ++e) {
+    auto& t = tets[e];
+    const double vol6 = signed_volume6(mesh.X, t);
+    const double l = longest_edge(mesh.X, t);
+    // Relative to the element's size: a sliver whose volume is 1e-10 of a cube on
+    // its longest edge is numerically flat and would make Dm singular.
+    if (!(std::abs(vol6) > 1e-10 * l * l * l))
+      fail(name, "tetrahedron " + std::to_string(e) + " is degenerate (volume " +
+                     std::to_string(vol6 / 6.0) + ")");
+    if (vol6 < 0.0) {
+      std::swap(t[2], t[3]);
+      ++mesh.reoriented_tets;
+    }
+  }
+  mesh.tets = std::move(tets);
+  mesh.boundary = boundary_triangles(mesh.tets);
+  return mesh;
+}
+
+TetMesh load_mesh(const std::string& path) {
+  {
+    std::ifstream probe(path);
+    if (!probe) fail(path, "cannot open the file (missing or unreadable)");
+  }
+  std::lock_guard<std::mutex> lock(gmsh_mutex());
+  ensure_gmsh_initialized();
+  gmsh::clear();
+  try {
+    gmsh::open(path);
+  } catch (const std::exception& e) {
+    reset_gmsh();
+    fail(path, std::string("gmsh cannot read it as a mesh file: ") + e.what());
+  } catch (...) {
+    reset_gmsh();
+    fail(path, "gmsh cannot read it as a mesh file");
+  }
+
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, params;
+  gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, false, false);
+  std::vector<std::size_t> elem_tags, elem_nodes;
+  gmsh::model::mesh::getElementsByType(4, elem_tags, elem_nodes);  // 4 = linear tetrahedron
+  gmsh::clear();
+  if (node_tags.empty()) fail(path, "not a mesh: gmsh found no nodes in it");
+
+  std::unordered_map<std::size_t, int> index_of_tag;
+  index_of_tag.reserve(node_tags.size());
+  Eigen::Matrix3Xd X(3, static_cast<Eigen::Index>(node_tags.size()));
+  for (std::size_t i = 0; i < node_tags.size(); ++i) {
+    index_of_tag.emplace(node_tags[i], static_cast<int>(i));
+    X.col(static_cast<Eigen::Index>(i)) << coords[3 * i], coords[3 * i + 1], coords[3 * i + 2];
+  }
+  std::vector<Eigen::Vector4i> tets(elem_tags.size());
+  for (std::size_t e = 0; e < elem_tags.size(); ++e) {
+    for (int k = 0; k < 4; ++k) {
+      const auto it = index_of_tag.find(elem_nodes[4 * e + k]);
+      if (it == index_of_tag.end()) fail(path, "a tetrahedron refers to an undefined node");
+      tets[e][k] = it->second;
+    }
+  }
+  return make_mesh(std::move(X), std::move(tets), path);
+}
+
+std::vector<std::vector<int>> node_adjacency(const TetMesh& mesh) {
+  std::vector<std::vector<int>> adj(static_cast<std::size_t>(mesh.num_nodes()));
+  for (const auto& t : mesh.tets)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) adj[t[a]].push_back(t[b]);
+  for (auto& row : adj) {
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
+  return adj;
+}
+
+std::vector<Eigen::Vector3i> boundary_triangles(const std::vector<Eigen::Vector4i>& tets) {
+  // Faces of a positively oriented tet (0,1,2,3), each seen from outside counter-clockwise.
+  static constexpr std::array<std::array<int, 3>, 4> faces = {
+      {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  std::map<std::array<int, 3>, std::pair<Eigen::Vector3i, int>> seen;
+  for (const auto& t : tets) {
+    for (const auto& f : faces) {
+      const Eigen::Vector3i tri(t[f[0]], t[f[1]], t[f[2]]);
+      std::array<int, 3> key = {tri[0], tri[1], tri[2]};
+      std::sort(key.begin(), key.end());
+      auto [it, inserted] = seen.try_emplace(key, tri, 0);
+      ++it->second.second;
+    }
+  }
+  std::vector<Eigen::Vector3i> out;
+  for (const auto& [key, value] : seen)
+    if (value.second == 1) out.push_back(value.first);
+  return out;
+}
+
+}  // namespace fem

@@ -1,0 +1,43 @@
+// A linear tetrahedral mesh read from a gmsh .msh file through the gmsh C++ API.
+#pragma once
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fem {
+
+struct TetMesh {
+  Eigen::Matrix3Xd X;                     // rest positions, one column per node
+  std::vector<Eigen::Vector4i> tets;      // positively oriented: det(Dm) > 0
+  std::vector<Eigen::Vector3i> boundary;  // boundary triangles, outward normals
+  std::string file;                       // where it came from (for messages and results)
+  int reoriented_tets = 0;                // inverted tets flipped on load
+  int dropped_nodes = 0;                  // nodes used by no tetrahedron, removed on load
+
+  int num_nodes() const { return static_cast<int>(X.cols()); }
+  int num_tets() const { return static_cast<int>(tets.size()); }
+};
+
+// Thrown for every problem with a mesh file; what() names the file and the problem.
+struct MeshError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Loads the tetrahedra (gmsh element type 4) of a .msh file. Validates: the file
+// exists and is a mesh, it has tetrahedra, coordinates are finite, no tetrahedron is
+// degenerate. Inverted tetrahedra are reoriented and counted; unused nodes dropped.
+TetMesh load_mesh(const std::string& path);
+
+// Builds a mesh from arrays (tests and generated scenes), with the same validation.
+TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets,
+                  const std::string& name = "<memory>");
+
+// Node pairs (i, j) sharing a tetrahedron, i and j included: the sparsity of the system.
+std::vector<std::vector<int>> node_adjacency(const TetMesh& mesh);
+
+// Boundary triangles: faces that belong to exactly one tetrahedron, oriented outward.
+std::vector<Eigen::Vector3i> boundary_triangles(const std::vector<Eigen::Vector4i>& tets);
+
+}  // namespace fem

@@ -1,0 +1,81 @@
+// The interface every chapter implements, and what it measures about each step.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include "common/scene.hpp"
+
+namespace fem {
+
+// What one phase of a step cost: time, and heap allocations when the allocation counter
+// is linked into the program (tests, benchmarks); zero allocations otherwise.
+struct PhaseCost {
+  double seconds = 0.0;
+  long long allocations = 0;
+};
+
+// The poster's phases during the last step, plus solver facts.
+struct StepProfile {
+  PhaseCost forces;       // rotations and element forces (identical in every chapter)
+  PhaseCost dfdx;         // df/dx construction: clean the matrix, scatter -R K0 R^T
+  PhaseCost compose;      // system composition: A = M - h df/dv - h^2 df/dx, and b
+  PhaseCost constraints;  // the filter: S A S + I - S and S (b - A z)
+  PhaseCost solve;        // the linear solve
+  PhaseCost step;         // the whole step, all of the above and the update
+  int cg_iterations = 0;
+  double relative_residual = 0.0;  // ||r|| / ||rhs|| of the last solve
+  bool converged = true;           // false when the solve stopped at the iteration cap
+};
+
+// Conjugate gradient settings, the same for every chapter so that timings compare.
+// Eigen's default tolerance is machine epsilon: always set it explicitly.
+struct SolverSettings {
+  double tolerance = 1e-4;   // relative residual ||r|| <= tolerance * ||rhs||
+  int max_iterations = 2000;
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  // Advances the state by one linearized backward Euler step of scene.dt.
+  virtual void step(State& state) = 0;
+  virtual const StepProfile& profile() const = 0;
+};
+
+// Set by the allocation counter when it is linked into the program: the number of heap
+// allocations so far. Null otherwise (the steppers do not depend on the counter).
+extern long long (*allocation_count_hook)();
+
+// Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(PhaseCost& cost)
+      : cost_(cost), allocations_(count_allocations()), start_(Clock::now()) {}
+  ~PhaseTimer() {
+    cost_.seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    cost_.allocations = count_allocations() - allocations_;
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  static long long count_allocations() {
+    return allocation_count_hook ? allocation_count_hook() : 0;
+  }
+  PhaseCost& cost_;
+  long long allocations_;
+  Clock::time_point start_;
+};
+
+}  // namespace fem
+
+namespace fem {
+
+// Prints one warning the first time a stepper's solve stops at the iteration cap, so
+// that non-convergence is never silent and never floods the output.
+void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
+                             const char* chapter, bool& already_warned);
+
+}  // namespace fem

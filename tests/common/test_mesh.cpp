@@ -1,0 +1,113 @@
+// Mesh loading through gmsh: the committed test mesh, and every bad input with its
+// clear error message.
+#include <catch2/catch.hpp>
+#include <Eigen/LU>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include "common/mesh.hpp"
+#include "support.hpp"
+
+using namespace fem;
+using Catch::Matchers::Contains;
+
+namespace {
+
+// Writes a small MSH 2.2 file: nodes "x y z" and elements (gmsh type, node list).
+std::string write_msh(const std::string& name, const std::vector<std::string>& nodes,
+                      const std::vector<std::pair<int, std::string>>& elements) {
+  const auto path = std::filesystem::temp_directory_path() / ("fem_test_" + name + ".msh");
+  std::ofstream out(path);
+  out << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << nodes.size() << "\n";
+  for (std::size_t i = 0; i < nodes.size(); ++i) out << i + 1 << " " << nodes[i] << "\n";
+  out << "$EndNodes\n$Elements\n" << elements.size() << "\n";
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    out << e + 1 << " " << elements[e].first << " 2 0 1 " << elements[e].second << "\n";
+  out << "$EndElements\n";
+  return path.string();
+}
+
+const std::vector<std::string> kUnitTet = {"0 0 0", "1 0 0", "0 1 0", "0 0 1"};
+
+}  // namespace
+
+TEST_CASE("the committed test mesh loads with its boundary", "[mesh]") {
+  const TetMesh mesh = test::test_mesh();
+  CHECK(mesh.num_nodes() > 0);
+  CHECK(mesh.num_nodes() <= 300);
+  CHECK(mesh.num_tets() > 0);
+  CHECK(mesh.dropped_nodes == 0);
+  // A closed surface: every boundary edge is shared by exactly two boundary triangles,
+  // and by Euler's formula for a sphere-like surface V - E + F = 2.
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : mesh.boundary)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, count] : edges) CHECK(count == 2);
+  std::set<int> surface_nodes;
+  for (const auto& t : mesh.boundary) surface_nodes.insert({t[0], t[1], t[2]});
+  CHECK(static_cast<long>(surface_nodes.size()) - static_cast<long>(edges.size()) +
+            static_cast<long>(mesh.boundary.size()) ==
+        2);
+}
+
+TEST_CASE("a missing file is reported with its name", "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh("/nonexistent/nothing.msh"),
+                    Contains("/nonexistent/nothing.msh") && Contains("cannot open"));
+}
+
+TEST_CASE("a file that is not a mesh is reported", "[mesh]") {
+  const auto path = std::filesystem::temp_directory_path() / "fem_test_not_a_mesh.msh";
+  std::ofstream(path) << "this is not a mesh\n";
+  CHECK_THROWS_AS(load_mesh(path.string()), MeshError);
+  CHECK_THROWS_WITH(load_mesh(path.string()), Contains(path.string()));
+}
+
+TEST_CASE("a mesh without tetrahedra is reported", "[mesh]") {
+  const auto path = write_msh("no_tets", {"0 0 0", "1 0 0", "0 1 0"}, {{2, "1 2 3"}});
+  CHECK_THROWS_WITH(load_mesh(path), Contains("no tetrahedra"));
+}
+
+TEST_CASE("a degenerate tetrahedron is reported", "[mesh]") {
+  const auto path = write_msh("flat", {"0 0 0", "1 0 0", "0 1 0", "1 1 0"}, {{4, "1 2 3 4"}});
+  CHECK_THROWS_WITH(load_mesh(path), Contains("degenerate"));
+}
+
+TEST_CASE("NaN or infinite coordinates are reported", "[mesh]") {
+  auto nodes = kUnitTet;
+  nodes[2] = "0 nan 0";
+  CHECK_THROWS_WITH(load_mesh(write_msh("nan", nodes, {{4, "1 2 3 4"}})), Contains("NaN"));
+  nodes[2] = "0 inf 0";
+  CHECK_THROWS_WITH(load_mesh(write_msh("inf", nodes, {{4, "1 2 3 4"}})), Contains("infinite"));
+}
+
+TEST_CASE("an inverted tetrahedron is reoriented and counted", "[mesh]") {
+  const TetMesh mesh = load_mesh(write_msh("inverted", kUnitTet, {{4, "1 3 2 4"}}));
+  REQUIRE(mesh.num_tets() == 1);
+  CHECK(mesh.reoriented_tets == 1);
+  Eigen::Matrix3d Dm;
+  for (int i = 0; i < 3; ++i) Dm.col(i) = mesh.X.col(mesh.tets[0][i + 1]) - mesh.X.col(mesh.tets[0][0]);
+  CHECK(Dm.determinant() > 0.0);
+  CHECK(mesh.boundary.size() == 4);
+}
+
+TEST_CASE("nodes used by no tetrahedron are dropped", "[mesh]") {
+  auto nodes = kUnitTet;
+  nodes.insert(nodes.begin(), "5 5 5");  // node 1 is unused
+  // gmsh itself may already skip a node no element uses: either way it is gone.
+  CHECK(load_mesh(write_msh("unused", nodes, {{4, "2 3 4 5"}})).num_nodes() == 4);
+
+  Eigen::Matrix3Xd X(3, 5);
+  X << 5, 0, 1, 0, 0,  //
+      5, 0, 0, 1, 0,   //
+      5, 0, 0, 0, 1;
+  const TetMesh mesh = make_mesh(X, {Eigen::Vector4i(1, 2, 3, 4)});
+  CHECK(mesh.num_nodes() == 4);
+  CHECK(mesh.dropped_nodes == 1);
+  CHECK(mesh.X.col(0).norm() == 0.0);  // renumbered: the first used node, (0, 0, 0)
+  CHECK(mesh.tets[0] == Eigen::Vector4i(0, 1, 2, 3));
+}

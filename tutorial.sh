@@ -1,0 +1,140 @@
+#!/usr/bin/env bash
+# One entry point for the tutorial: set-up, build, tests, benchmark, simulation.
+# Every subcommand sets up what is missing first (idempotent), so a fresh clone of the
+# repository on Debian 12 needs nothing but this script.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+cd "$ROOT"
+PRESET="${PRESET:-release}"           # release | debug | asan
+BUILD_DIR="$ROOT/build/$PRESET"
+VENV="$ROOT/.venv"
+
+APT_PACKAGES=(
+  build-essential cmake ninja-build git python3 python3-venv
+  libeigen3-dev catch2
+  # gmsh's runtime libraries (the PyPI wheel links against them)
+  libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
+)
+
+usage() {
+  cat <<USAGE
+usage: ./tutorial.sh <command> [arguments passed to the program]
+
+commands:
+  setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
+  build      set up if needed and build (preset: \$PRESET, default release)
+  test       build and run every test through ctest (ctest arguments may follow, e.g. -L ch01)
+  bench      build and benchmark every chapter on the poster-sized mesh:
+             prints the per-phase table, writes results/bench.json (and plots when present)
+  sim        build and run the cantilever on the poster-sized mesh, VTK frames in out/sim/
+  meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
+  help       this text (also --help, -h)
+
+environment:
+  PRESET=release|debug|asan   which CMake preset to build and test with (default release)
+USAGE
+}
+
+log() { printf '\033[1m==> %s\033[0m\n' "$*"; }
+
+missing_packages() {
+  local p
+  for p in "${APT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || echo "$p"
+  done
+}
+
+install_system_packages() {
+  local missing
+  missing=$(missing_packages | tr '\n' ' ')
+  [ -z "${missing// /}" ] && return 0
+  if [ "$(id -u)" -eq 0 ]; then
+    log "installing Debian packages: $missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    # shellcheck disable=SC2086
+    apt-get install -y -qq --no-install-recommends $missing
+  else
+    echo "Missing Debian packages. Please run:" >&2
+    echo "  sudo apt-get install -y $missing" >&2
+    echo "then run ./tutorial.sh again." >&2
+    exit 1
+  fi
+}
+
+setup_venv() {
+  local stamp="$VENV/.requirements.sha256"
+  local want
+  want=$(sha256sum requirements.txt | cut -d' ' -f1)
+  if [ -x "$VENV/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+    return 0
+  fi
+  log "creating .venv and installing requirements.txt (gmsh, matplotlib)"
+  [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
+  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r requirements.txt
+  echo "$want" >"$stamp"
+}
+
+configure() {
+  if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+    log "configuring (preset $PRESET)"
+    cmake --preset "$PRESET"
+  fi
+}
+
+setup() {
+  install_system_packages
+  setup_venv
+  configure
+}
+
+build() {
+  setup
+  log "building (preset $PRESET)"
+  cmake --build --preset "$PRESET"
+}
+
+run_tests() {
+  build
+  log "running the tests"
+  ctest --preset "$PRESET" -j "$(nproc)" "$@"
+}
+
+bench() {
+  build
+  mkdir -p results
+  log "benchmarking every chapter on the poster-sized mesh"
+  "$BUILD_DIR/fem_bench" --json results/bench.json "$@"
+  if [ -f scripts/plot_results.py ]; then
+    log "plotting"
+    "$VENV/bin/python" scripts/plot_results.py results/bench.json --out results
+  fi
+}
+
+sim() {
+  build
+  "$BUILD_DIR/fem_sim" "$@"
+}
+
+meshes() {
+  setup_venv
+  "$VENV/bin/python" meshes/generate.py "$@"
+}
+
+cmd="${1:-help}"
+[ $# -gt 0 ] && shift
+case "$cmd" in
+  setup) setup ;;
+  build) build ;;
+  test) run_tests "$@" ;;
+  bench) bench "$@" ;;
+  sim) sim "$@" ;;
+  meshes) meshes "$@" ;;
+  help | --help | -h) usage ;;
+  *)
+    echo "tutorial.sh: unknown command '$cmd'" >&2
+    usage >&2
+    exit 2
+    ;;
+esac
