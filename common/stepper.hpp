@@ -4,6 +4,7 @@
 #include <chrono>
 #include <string>
 
+#include "common/allocation_hook.hpp"
 #include "common/scene.hpp"
 
 namespace fem {
@@ -42,10 +43,6 @@ class Stepper {
   virtual void step(State& state) = 0;
   virtual const StepProfile& profile() const = 0;
 };
-
-// Set by the allocation counter when it is linked into the program: the number of heap
-// allocations so far. Null otherwise (the steppers do not depend on the counter).
-extern long long (*allocation_count_hook)();
 
 // Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.
 class PhaseTimer {

@@ -55,7 +55,8 @@ Deflection static_deflection(const std::string& file) {
 
 TEST_CASE("clamped beam deflection converges to Euler-Bernoulli with refinement", "[beam]") {
   std::vector<Deflection> series;
-  for (const char* file : {"beam_2k.msh", "beam_10k.msh"}) {
+  for (const char* file :
+       {"beam_500.msh", "beam_1k.msh", "beam_2k.msh", "beam_5k.msh", "beam_10k.msh"}) {
     series.push_back(static_deflection(file));
     const Deflection& d = series.back();
     std::cout << "beam " << d.nodes << " nodes: FEM " << d.fem << " m, Euler-Bernoulli "
@@ -63,9 +64,10 @@ TEST_CASE("clamped beam deflection converges to Euler-Bernoulli with refinement"
     CHECK(d.fem > 0.0);
     CHECK(d.fem < 1.05 * d.theory);  // shear (Timoshenko) adds < 1% at L/h = 10
   }
-  // The error falls from the coarsest to the finest mesh, and the finest is close.
-  const double coarse = std::abs(1.0 - series.front().fem / series.front().theory);
-  const double fine = std::abs(1.0 - series.back().fem / series.back().theory);
-  CHECK(fine < coarse);
-  CHECK(fine < 0.10);
+  // Every refinement brings the deflection closer to the theory (the series is nested in
+  // size, not in mesh, so this is measured, not guaranteed: it held for all five meshes),
+  // and the finest mesh is within 5%.
+  for (std::size_t k = 1; k < series.size(); ++k)
+    CHECK(series[k].fem / series[k].theory > series[k - 1].fem / series[k - 1].theory);
+  CHECK(std::abs(1.0 - series.back().fem / series.back().theory) < 0.05);
 }
