@@ -8,6 +8,7 @@
 #include "chapters/04_system_composition/stepper.hpp"
 #include "chapters/05_inplace_constraints/stepper.hpp"
 #include "chapters/06_custom_pcg/stepper.hpp"
+#include "chapters/07_block_sparse/stepper.hpp"
 
 namespace fem {
 namespace {
@@ -29,6 +30,7 @@ const std::vector<ChapterInfo>& chapters() {
       chapter<ch04::SystemCompositionStepper>("04_system_composition", "A and b in one pass over shared value arrays"),
       chapter<ch05::InplaceConstraintsStepper>("05_inplace_constraints", "S A S^T applied in place, no S"),
       chapter<ch06::CustomPcgStepper>("06_custom_pcg", "our own PCG: warm start, no allocations"),
+      chapter<ch07::BlockSparseStepper>("07_block_sparse", "3x3 block sparse matrix, block Jacobi"),
   };
   return list;
 }
