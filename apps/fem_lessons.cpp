@@ -3,6 +3,8 @@
 // no number in a lesson is typed by hand).
 //   noalias    chapter 02: heap allocations of each vector statement, before and after
 //   dfdx-fill  chapter 03: df/dx construction by coeffRef, by setFromTriplets, by the table
+//   spmv       chapter 07: SpMV by Eigen (both storage orders) and by 3x3 blocks (full and
+//              symmetric storage), and block Jacobi against scalar Jacobi in the PCG
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -12,6 +14,8 @@
 #include <sstream>
 
 #include "chapters/02_noalias/statements.hpp"
+#include "chapters/06_custom_pcg/stepper.hpp"
+#include "chapters/07_block_sparse/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
@@ -102,6 +106,88 @@ std::string dfdx_fill_table(const Scene& scene, int steps) {
   return out.str();
 }
 
+// Median milliseconds of `repeat` runs of f.
+template <class F>
+double time_ms(int repeat, F&& f) {
+  std::vector<double> ms;
+  for (int k = 0; k < repeat; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return median(ms);
+}
+
+std::string spmv_table(const Scene& scene, int steps) {
+  ch07::BlockSparseStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 10; ++k) stepper.step(state);  // a real, filtered system
+  const ch07::BlockSparseMatrix& A = stepper.system_matrix();
+  const ch07::BlockSparseMatrix upper = A.upper();
+  const Eigen::SparseMatrix<double> csc = A.to_sparse();
+  const Eigen::VectorXd x = Eigen::VectorXd::Ones(csc.cols());
+  Eigen::VectorXd y(x.size());
+  const int repeat = 20 * steps;
+  const double eigen_col = time_ms(repeat, [&] { y.noalias() = csc * x; });
+  const double eigen_row = time_ms(repeat, [&] { y.noalias() = csc.transpose() * x; });
+  const double block_full = time_ms(repeat, [&] { A.multiply(x, y); });
+  const double block_upper = time_ms(repeat, [&] { upper.multiply_upper(x, y); });
+  const long long nnz = csc.nonZeros();
+  const std::size_t nb = A.blocks.size();
+  // Index memory: CSC stores one row index per entry and one pointer per column; BSR one
+  // column index per block and one pointer per block row.
+  const double csc_index_kb = (nnz + csc.cols() + 1) * sizeof(int) / 1024.0;
+  const double bsr_index_kb = (nb + A.row_start.size()) * sizeof(int) / 1024.0;
+
+  // The PCG on the same system: scalar Jacobi (chapter 06, on the CSC copy) and block
+  // Jacobi (chapter 07).
+  const Eigen::VectorXd& b = stepper.system_rhs();
+  const std::vector<int> offsets = ch06::diagonal_offsets(csc);
+  SolverSettings settings;
+  ch06::PcgWorkspace work6;
+  ch07::PcgWorkspace work7;
+  Eigen::VectorXd y6, y7;
+  ch06::PcgResult r6;
+  ch07::PcgResult r7;
+  const double pcg6 = time_ms(steps, [&] {
+    y6.setZero(b.size());
+    r6 = ch06::pcg_solve(csc, b, scene.constraints, offsets, settings, work6, y6);
+  });
+  const double pcg7 = time_ms(steps, [&] {
+    y7.setZero(b.size());
+    r7 = ch07::pcg_solve(A, stepper.diagonal_blocks(), b, scene.constraints, settings, work7, y7);
+  });
+
+  const BuildInfo info = build_info();
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(4);
+  out << "| SpMV, y = A x | median ms | vs Eigen column-major | index memory (KiB) |\n"
+      << "| --- | ---: | ---: | ---: |\n"
+      << "| Eigen CSC, `A * x` (column scatter) | " << eigen_col << " | 1.00x | "
+      << std::setprecision(0) << csc_index_kb << " |\n"
+      << std::setprecision(4) << "| Eigen CSC, `A.transpose() * x` (row gather, chapter 06) | "
+      << eigen_row << " | " << std::setprecision(2) << eigen_col / eigen_row << "x | "
+      << std::setprecision(0) << csc_index_kb << " |\n"
+      << std::setprecision(4) << "| 3x3 blocks, full storage (chapter 07) | " << block_full << " | "
+      << std::setprecision(2) << eigen_col / block_full << "x | " << std::setprecision(0)
+      << bsr_index_kb << " |\n"
+      << std::setprecision(4) << "| 3x3 blocks, symmetric (upper) storage | " << block_upper
+      << " | " << std::setprecision(2) << eigen_col / block_upper << "x | " << std::setprecision(0)
+      << (upper.blocks.size() + upper.row_start.size()) * sizeof(int) / 1024.0 << " |\n\n";
+  out << "| PCG from zero, same system and tolerance | median ms | iterations |\n"
+      << "| --- | ---: | ---: |\n"
+      << std::setprecision(3) << "| scalar Jacobi on CSC (chapter 06) | " << pcg6 << " | "
+      << r6.iterations << " |\n"
+      << "| block Jacobi on 3x3 blocks (chapter 07) | " << pcg7 << " | " << r7.iterations
+      << " |\n\n";
+  out << "The filtered system of step 10 of the " << scene.name << " scene on "
+      << std::filesystem::path(scene.mesh.file).filename().string() << " ("
+      << scene.mesh.num_nodes() << " nodes, " << nnz << " non-zeros, " << nb << " blocks); "
+      << cpu_model() << ", " << info.compiler << ", `" << info.flags
+      << "`. Generated by `fem_lessons spmv`.\n";
+  return out.str();
+}
+
 // Replaces the text between <!-- NAME:begin --> and <!-- NAME:end --> in a file.
 void write_between_markers(const std::string& path, const std::string& name,
                            const std::string& text) {
@@ -122,15 +208,16 @@ void write_between_markers(const std::string& path, const std::string& name,
 
 int main(int argc, char** argv) {
   const std::string usage =
-      "usage: fem_lessons noalias|dfdx-fill [options]\n"
+      "usage: fem_lessons noalias|dfdx-fill|spmv [options]\n"
       "  noalias    allocations of each vector statement of chapter 01 and its chapter 02 rewrite\n"
-      "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n";
+      "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n"
+      "  spmv       SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi\n";
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::cout << usage << "(fem_lessons LESSON --help for the options)\n";
     return argc < 2 ? 2 : 0;
   }
   const std::string lesson = argv[1];
-  if (lesson != "noalias" && lesson != "dfdx-fill") {
+  if (lesson != "noalias" && lesson != "dfdx-fill" && lesson != "spmv") {
     std::cerr << "fem_lessons: unknown lesson '" << lesson << "'\n" << usage;
     return 2;
   }
@@ -143,8 +230,9 @@ int main(int argc, char** argv) {
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
-    const std::string table =
-        lesson == "noalias" ? noalias_table(scene) : dfdx_fill_table(scene, steps);
+    const std::string table = lesson == "noalias"     ? noalias_table(scene)
+                              : lesson == "dfdx-fill" ? dfdx_fill_table(scene, steps)
+                                                      : spmv_table(scene, steps);
     std::cout << table;
     if (const std::string& readme = args.get("readme"); !readme.empty()) {
       write_between_markers(readme, lesson + "-table", table);
