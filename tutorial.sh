@@ -27,6 +27,12 @@ commands:
   test       build and run every test through ctest (ctest arguments may follow, e.g. -L ch01)
   bench      build and benchmark every chapter on the poster-sized mesh:
              prints the per-phase table, writes results/bench.json (and plots when present)
+  scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
+             meshes generated on demand), with a time budget per run: results/scaling.json and
+             results/scaling.png
+  docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
+             the README and the chapter READMEs, plots copied to docs/images/) and the lesson
+             tables (fem_lessons); run bench (and scaling) first
   sim        build and run the cantilever on the poster-sized mesh, VTK frames in out/sim/
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
   help       this text (also --help, -h)
@@ -112,6 +118,24 @@ bench() {
   fi
 }
 
+scaling() {
+  build
+  log "scaling over the beam series (a time budget per run; --help for the options)"
+  "$VENV/bin/python" scripts/scaling.py --bench "$BUILD_DIR/fem_bench" --out results/scaling.json "$@"
+  "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
+}
+
+docs() {
+  build
+  [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
+  log "lesson tables (fem_lessons)"
+  "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
+  log "results tables and plots"
+  "$VENV/bin/python" scripts/update_docs.py --images docs/images
+}
+
 sim() {
   build
   "$BUILD_DIR/fem_sim" "$@"
@@ -129,6 +153,8 @@ case "$cmd" in
   build) build ;;
   test) run_tests "$@" ;;
   bench) bench "$@" ;;
+  scaling) scaling "$@" ;;
+  docs) docs ;;
   sim) sim "$@" ;;
   meshes) meshes "$@" ;;
   help | --help | -h) usage ;;

@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""Plots the benchmark results: from results/bench.json only (no numbers typed here).
+
+    plot_results.py results/bench.json --out results       phases, speedup, allocations, solvers
+    plot_results.py --scaling results/scaling.json --out results     scaling
+"""
+import argparse
+import pathlib
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # noqa: E402
+                            POSTER_SOLVE_MS, ResultsError, die, footer, load_checked)
+
+
+def finish(fig, data, path):
+    fig.text(0.01, 0.005, footer(data), fontsize=6.5, color="0.35", ha="left", va="bottom", wrap=True)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+    print(f"wrote {path}")
+
+
+def chapter_labels(chapters):
+    return [c["chapter"] for c in chapters]
+
+
+def plot_phases(data, out):
+    chapters = data["chapters"]
+    phases = ["forces"] + PHASES
+    x = np.arange(len(phases))
+    width = 0.8 / len(chapters)
+    fig, ax = plt.subplots(figsize=(11, 5))
+    for i, c in enumerate(chapters):
+        med = np.array([c["median_ms"][p] for p in phases])
+        lo = med - np.array([c["q1_ms"][p] for p in phases])
+        hi = np.array([c["q3_ms"][p] for p in phases]) - med
+        ax.bar(x + (i - (len(chapters) - 1) / 2) * width, np.maximum(med, 1e-4), width,
+               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"])
+    ax.set_yscale("log")
+    ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
+    ax.set_ylabel("median time per step [ms] (log; bars: quartiles)")
+    ax.set_title("Time per phase of one step, chapter by chapter")
+    ax.legend(fontsize=8, ncol=2)
+    ax.grid(axis="y", which="both", alpha=0.3)
+    finish(fig, data, out / "phases.png")
+
+
+def plot_speedup(data, out):
+    chapters = data["chapters"]
+    base = next((c for c in chapters if c["chapter"] == BASELINE), None)
+    fig, ax = plt.subplots(figsize=(11, 5))
+    if base is None or len(chapters) < 2:
+        ax.text(0.5, 0.5, "only one chapter measured: no speedup to show" if base else
+                f"no {BASELINE} in the results: no baseline", ha="center", va="center")
+        ax.set_axis_off()
+        ax.set_title("Speedup over chapter 01")
+        finish(fig, data, out / "speedup.png")
+        return
+    others = [c for c in chapters if c is not base]
+    x = np.arange(len(PHASES))
+    width = 0.8 / (len(others) + 1)
+    for i, c in enumerate(others):
+        s = [base["median_ms"][p] / max(c["median_ms"][p], 1e-9) for p in PHASES]
+        ax.bar(x + (i - len(others) / 2) * width, s, width, label=c["chapter"])
+    poster = [POSTER_SPEEDUPS.get(p, np.nan) for p in PHASES]
+    ax.bar(x + (len(others) - len(others) / 2) * width, poster, width, color="none",
+           edgecolor="black", hatch="//", label="poster (optimized vs naive)")
+    ax.axhline(1.0, color="0.3", lw=0.8)
+    ax.set_yscale("log")
+    ax.set_xticks(x, [PHASE_LABELS[p] for p in PHASES])
+    ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
+    ax.set_title("Speedup per phase over the naive stepper, beside the poster's")
+    ax.legend(fontsize=8, ncol=2)
+    ax.grid(axis="y", which="both", alpha=0.3)
+    finish(fig, data, out / "speedup.png")
+
+
+def plot_allocations(data, out):
+    chapters = data["chapters"]
+    counts = [c["allocations_per_step"] for c in chapters]
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts], color="tab:red")
+    for bar, a in zip(bars, counts):
+        ax.annotate(f"{a:g}", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
+                    ha="center", va="bottom", fontsize=9)
+    ax.set_yscale("log")
+    ax.set_ylim(0.3, max(counts + [1]) * 3)
+    ax.set_ylabel("heap allocations per step (log; 0 drawn at 0.5)")
+    ax.set_title("Heap allocations per step (after the first)")
+    ax.tick_params(axis="x", rotation=20)
+    finish(fig, data, out / "allocations.png")
+
+
+def plot_solvers(data, out):
+    solvers = data.get("solvers")
+    if not solvers:
+        return
+    names = [s["name"] for s in solvers]
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
+    ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
+    poster = [POSTER_SOLVE_MS.get(n) for n in names]
+    ys = [i for i, p in enumerate(poster) if p is not None]
+    ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
+    ax1.invert_yaxis()
+    ax1.set_xlabel("median time per solve [ms]")
+    ax1.set_title("Time per solve")
+    ax1.legend(fontsize=8)
+    ax2.barh(names, [s["iterations"] for s in solvers], color="tab:green")
+    ax2.invert_yaxis()
+    ax2.set_xlabel("CG iterations per solve (median; 0 for a direct solver)")
+    ax2.set_title("Iterations")
+    fig.suptitle("The solve table: the same systems, the same tolerance")
+    finish(fig, data, out / "solvers.png")
+
+
+def plot_scaling(data, out):
+    runs = data["runs"]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+    chapters = sorted({r["chapter"] for r in runs})
+    for key, ax, title in (("step_ms", axes[0], "overall step"), ("solve_ms", axes[1], "solve")):
+        for c in chapters:
+            pts = sorted((r["nodes"], r[key]) for r in runs if r["chapter"] == c)
+            xs, ys = zip(*pts)
+            line, = ax.plot(xs, ys, marker="o", ms=3)
+            ax.annotate(c, (xs[-1], ys[-1]), xytext=(4, 0), textcoords="offset points",
+                        fontsize=7, color=line.get_color(), va="center")
+            stopped = [s for s in data.get("skipped", []) if s["chapter"] == c]
+            if stopped:
+                ax.scatter([xs[-1]], [ys[-1]], marker="x", s=60, color=line.get_color(), zorder=3)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("nodes")
+        ax.set_ylabel(f"median {title} time [ms]")
+        ax.set_title(f"{title.capitalize()} against mesh size (x: stopped, over budget)")
+        ax.grid(which="both", alpha=0.3)
+    finish(fig, data, out / "scaling.png")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("bench", nargs="?", help="results/bench.json")
+    parser.add_argument("--scaling", help="results/scaling.json")
+    parser.add_argument("--out", default="results", help="directory for the PNG files")
+    args = parser.parse_args()
+    if not args.bench and not args.scaling:
+        parser.error("give a bench.json, or --scaling scaling.json")
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        if args.bench:
+            data = load_checked(args.bench)
+            plot_phases(data, out)
+            plot_speedup(data, out)
+            plot_allocations(data, out)
+            plot_solvers(data, out)
+        if args.scaling:
+            plot_scaling(load_checked(args.scaling, scaling=True), out)
+    except ResultsError as e:
+        die(f"plot_results.py: {e}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,131 @@
+"""What the plotting and the docs scripts share: loading and checking the results JSON,
+the phases, the poster's reported numbers, and the footer every plot and table carries."""
+import json
+import pathlib
+import sys
+
+PHASES = ["dfdx", "compose", "constraints", "solve", "step"]
+ALL_PHASES = ["forces"] + PHASES
+PHASE_LABELS = {
+    "forces": "forces (shared)",
+    "dfdx": "df/dx construction",
+    "compose": "system composition",
+    "constraints": "constraints",
+    "solve": "solve",
+    "step": "overall step",
+}
+# The poster's reported speedups of the optimized stepper over the naive one (per phase),
+# and its solve table.
+POSTER_SPEEDUPS = {"dfdx": 5.487, "compose": 21.358, "constraints": 218.79, "step": 9.849}
+POSTER_SOLVE_MS = {"eigen_cg": 7.1, "eigen_cg_guess": 4.39, "pcg_ch06": 1.68}
+BASELINE = "01_naive"
+
+
+class ResultsError(Exception):
+    pass
+
+
+def load(path):
+    path = pathlib.Path(path)
+    if not path.exists():
+        raise ResultsError(f"{path}: no such file (run ./tutorial.sh bench first)")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise ResultsError(f"{path}: not valid JSON ({e})") from e
+
+
+def validate_bench(data):
+    """Returns the list of problems of a bench.json against the schema in README.md."""
+    problems = []
+
+    def need(obj, key, kind, where):
+        if not isinstance(obj, dict) or key not in obj:
+            problems.append(f"{where}: missing '{key}'")
+            return None
+        value = obj[key]
+        if kind is float:
+            ok = isinstance(value, (int, float)) and not isinstance(value, bool) and value >= 0
+        else:
+            ok = isinstance(value, kind) and not (kind is int and isinstance(value, bool))
+        if not ok:
+            problems.append(f"{where}.{key}: expected {kind.__name__}"
+                            f"{' >= 0' if kind is float else ''}, got {value!r}")
+            return None
+        return value
+
+    if not isinstance(data, dict):
+        return ["the top level is not an object"]
+    need(data, "schema_version", int, "bench")
+    mesh = need(data, "mesh", dict, "bench")
+    if mesh is not None:
+        need(mesh, "file", str, "mesh")
+        need(mesh, "nodes", int, "mesh")
+        need(mesh, "tets", int, "mesh")
+    need(data, "scene", str, "bench")
+    for key in ("steps", "warmup_steps", "cg_max_iterations"):
+        need(data, key, int, "bench")
+    for key in ("dt", "cg_tolerance"):
+        need(data, key, float, "bench")
+    build = need(data, "build", dict, "bench")
+    if build is not None:
+        for key in ("compiler", "flags", "build_type", "eigen"):
+            need(build, key, str, "build")
+    machine = need(data, "machine", dict, "bench")
+    if machine is not None:
+        need(machine, "cpu", str, "machine")
+    need(data, "commit", str, "bench")
+    chapters = need(data, "chapters", list, "bench")
+    if chapters is not None and not chapters:
+        problems.append("bench.chapters: empty")
+    for i, c in enumerate(chapters or []):
+        where = f"chapters[{i}]"
+        need(c, "chapter", str, where)
+        for table in ("median_ms", "min_ms", "q1_ms", "q3_ms", "max_ms"):
+            t = need(c, table, dict, where)
+            for phase in ALL_PHASES if t is not None else []:
+                need(t, phase, float, f"{where}.{table}")
+        for key in ("allocations_per_step", "cg_iterations", "relative_residual"):
+            need(c, key, float, where)
+    for i, s in enumerate(data.get("solvers", [])):
+        where = f"solvers[{i}]"
+        need(s, "name", str, where)
+        for key in ("median_ms", "iterations", "allocations_per_solve"):
+            need(s, key, float, where)
+    return problems
+
+
+def validate_scaling(data):
+    problems = []
+    if not isinstance(data, dict):
+        return ["the top level is not an object"]
+    for key in ("scene", "runs", "build", "machine"):
+        if key not in data:
+            problems.append(f"scaling: missing '{key}'")
+    for i, run in enumerate(data.get("runs", [])):
+        for key in ("chapter", "nodes", "step_ms", "solve_ms"):
+            if key not in run:
+                problems.append(f"runs[{i}]: missing '{key}'")
+    return problems
+
+
+def load_checked(path, scaling=False):
+    data = load(path)
+    problems = validate_scaling(data) if scaling else validate_bench(data)
+    if problems:
+        raise ResultsError(f"{path}: does not match the schema:\n  " + "\n  ".join(problems))
+    return data
+
+
+def footer(data):
+    b, m = data["build"], data["machine"]
+    mesh = data.get("mesh")
+    where = (f"{mesh['file']} ({mesh['nodes']} nodes, {mesh['tets']} tets), "
+             f"{data['scene']}, {data.get('steps', '?')} steps, " if mesh else f"{data['scene']}, ")
+    return (f"{where}CG tol {data['cg_tolerance']:g} | {m['cpu']} | "
+            f"{b['compiler']} {b['flags']} | Eigen {b['eigen']} | commit {data.get('commit', '?')}")
+
+
+def die(message):
+    print(message, file=sys.stderr)
+    sys.exit(2)

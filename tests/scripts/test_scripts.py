@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Tests of the results scripts on the committed fixture tests/fixtures/bench_fixture.json
+(a real fem_bench run on the test mesh): every plot is written and non-empty, the generated
+tables contain the fixture's numbers, and the schema check accepts the fixture and rejects
+broken copies. Run from anywhere; prints 'N passed, M failed' last."""
+import copy
+import json
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCRIPTS = ROOT / "scripts"
+FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
+sys.path.insert(0, str(SCRIPTS))
+import update_docs  # noqa: E402
+from results_common import validate_bench  # noqa: E402
+
+results = {"passed": 0, "failed": 0}
+
+
+def check(name, condition, detail=""):
+    results["passed" if condition else "failed"] += 1
+    print(f"{'ok  ' if condition else 'FAIL'} {name}{'' if condition else ': ' + detail}")
+
+
+def run(*args):
+    return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True)
+
+
+def scaling_fixture(bench):
+    runs = []
+    for k, nodes in enumerate([500, 1000, 2000, 5000]):
+        for c in bench["chapters"][:2]:
+            if c["chapter"] != "01_naive" or nodes < 5000:
+                runs.append({"chapter": c["chapter"], "mesh": f"beam_{nodes}", "nodes": nodes,
+                             "tets": 4 * nodes, "step_ms": c["median_ms"]["step"] * 2 ** k,
+                             "solve_ms": c["median_ms"]["solve"] * 2 ** k, "cg_iterations": 10,
+                             "allocations_per_step": 0})
+    return {"schema_version": 1, "scene": "cantilever", "steps": 5, "warmup_steps": 1, "dt": 0.01,
+            "cg_tolerance": 1e-4, "build": bench["build"], "machine": bench["machine"],
+            "commit": "fixture", "budget_seconds": 1.0, "runs": runs,
+            "skipped": [{"chapter": "01_naive", "mesh": "beam_5000", "reason": "over 1 s"}]}
+
+
+def main():
+    bench = json.loads(FIXTURE.read_text())
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        scaling = tmp / "scaling.json"
+        scaling.write_text(json.dumps(scaling_fixture(bench)))
+
+        # Plots: every file written and non-empty.
+        out = tmp / "plots"
+        p = run(SCRIPTS / "plot_results.py", FIXTURE, "--scaling", scaling, "--out", out)
+        check("plot_results.py exits 0", p.returncode == 0, p.stderr)
+        for png in ["phases", "speedup", "allocations", "solvers", "scaling"]:
+            f = out / f"{png}.png"
+            check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
+                  f"{f} missing or small")
+        p = run(SCRIPTS / "plot_results.py", tmp / "missing.json", "--out", out)
+        check("plot_results.py on a missing file exits 2 with a message",
+              p.returncode == 2 and "no such file" in p.stderr, p.stderr)
+
+        # Tables: a copy of the docs with the markers, filled from the fixture.
+        root = tmp / "repo"
+        for rel in ["README.md", "docs/results.md", "chapters/01_naive/README.md",
+                    "chapters/06_custom_pcg/README.md"]:
+            (root / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(ROOT / rel, root / rel)
+        (root / "results").mkdir()
+        shutil.copy(FIXTURE, root / "results" / "bench.json")
+        shutil.copy(scaling, root / "results" / "scaling.json")
+        p = run(SCRIPTS / "update_docs.py", "--root", root)
+        check("update_docs.py exits 0", p.returncode == 0, p.stderr)
+        results_md = (root / "docs" / "results.md").read_text()
+        naive = next(c for c in bench["chapters"] if c["chapter"] == "01_naive")
+        last = bench["chapters"][-1]
+        for phase in ["dfdx", "solve", "step"]:
+            text = update_docs.ms(naive["median_ms"][phase])
+            check(f"results.md shows 01's {phase} median {text}", text in results_md)
+        speed = update_docs.ratio(naive["median_ms"]["step"], last["median_ms"]["step"])
+        check(f"results.md shows the step speedup {speed}", speed in results_md)
+        check("results.md shows the poster's x218.79", "x218.79" in results_md)
+        check("results.md names the machine", bench["machine"]["cpu"] in results_md)
+        check("results.md shows the solve table",
+              all(f"`{s['name']}`" in results_md for s in bench["solvers"]))
+        check("results.md shows the scaling table", "stopped" in results_md)
+        readme = (root / "README.md").read_text()
+        check("README headline filled", update_docs.ms(last["median_ms"]["step"]) in readme)
+        chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
+        check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
+
+        # Schema: the fixture passes, broken copies fail.
+        check("fixture matches the schema", validate_bench(bench) == [], str(validate_bench(bench)))
+        broken = copy.deepcopy(bench)
+        del broken["chapters"][0]["median_ms"]["solve"]
+        check("a missing phase is caught", validate_bench(broken) != [])
+        broken = copy.deepcopy(bench)
+        broken["cg_tolerance"] = "tight"
+        check("a wrong type is caught", validate_bench(broken) != [])
+        bad = tmp / "broken.json"
+        bad.write_text(json.dumps(broken))
+        p = run(SCRIPTS / "validate_bench.py", bad)
+        check("validate_bench.py exits 1 on a broken file", p.returncode == 1, p.stdout + p.stderr)
+
+    print(f"{results['passed']} passed, {results['failed']} failed")
+    return 1 if results["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
