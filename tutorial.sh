@@ -33,7 +33,8 @@ commands:
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
              the README and the chapter READMEs, plots copied to docs/images/) and the lesson
              tables (fem_lessons); run bench (and scaling) first
-  sim        build and run the cantilever on the poster-sized mesh, VTK frames in out/sim/
+  sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
+             out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
   help       this text (also --help, -h)
 
@@ -138,7 +139,12 @@ docs() {
 
 sim() {
   build
-  "$BUILD_DIR/fem_sim" "$@"
+  log "simulating the cantilever on the poster-sized mesh (VTK frames in out/sim/)"
+  "$BUILD_DIR/fem_sim" --out out/sim --every 4 "$@"
+  log "rendering the frames to docs/images/cantilever.gif"
+  local pvd
+  pvd=$(ls -t out/sim/*.pvd | head -n 1)
+  "$VENV/bin/python" scripts/render_gif.py "$pvd" --out docs/images/cantilever.gif
 }
 
 meshes() {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include <Eigen/IterativeLinearSolvers>
@@ -50,6 +51,7 @@ Spread spread(std::vector<double> v) {
 
 struct ChapterResult {
   std::string chapter;
+  std::string title;
   std::array<Spread, 6> ms;  // per phase, milliseconds
   double allocations_per_step;  // median over the measured steps
   std::array<long long, 6> phase_allocations;  // per phase, the last measured step
@@ -59,37 +61,64 @@ struct ChapterResult {
   int not_converged_steps;
 };
 
-ChapterResult run_chapter(const ChapterInfo& chapter, const Scene& scene,
-                          const SolverSettings& solver, int warmup, int steps) {
-  auto stepper = chapter.make(scene, solver);
-  State state = rest_state(scene);
+// One chapter's stepper, state and samples while the benchmark runs.
+struct ChapterRun {
+  const ChapterInfo* chapter;
+  std::unique_ptr<Stepper> stepper;
+  State state;
   std::array<std::vector<double>, 6> seconds;
   std::vector<double> allocations, iterations;
-  ChapterResult r{chapter.id, {}, 0.0, {}, 0, 0.0, 0.0, 0};
+  ChapterResult result;
+};
+
+// Runs the chapters interleaved, one step of each in turn: when the machine's speed drifts
+// (a shared virtual machine, a CPU changing its clock), every chapter sees the same drift,
+// so their ratios hold even when the absolute times move.
+std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& chapters,
+                                        const Scene& scene, const SolverSettings& solver,
+                                        int warmup, int steps) {
+  std::vector<ChapterRun> runs;
+  for (const ChapterInfo* c : chapters)
+    runs.push_back({c, c->make(scene, solver), rest_state(scene), {}, {}, {},
+                    ChapterResult{c->id, c->title, {}, 0.0, {}, 0, 0.0, 0.0, 0}});
+  const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
-    alloc::Scope counter;
-    stepper->step(state);
-    const long long allocs = counter.allocations();
-    if (!state.x.allFinite())
-      throw std::runtime_error(chapter.id + ": the simulation diverged at step " +
-                               std::to_string(k + 1) + " (non-finite positions)");
-    if (k < warmup) continue;
-    const StepProfile& p = stepper->profile();
-    const auto s = phases(p);
-    for (std::size_t i = 0; i < s.size(); ++i) {
-      seconds[i].push_back(1e3 * s[i].seconds);
-      r.phase_allocations[i] = s[i].allocations;  // deterministic: the last step's
+    for (ChapterRun& run : runs) {
+      alloc::Scope counter;
+      run.stepper->step(run.state);
+      const long long allocs = counter.allocations();
+      if (!run.state.x.allFinite())
+        throw std::runtime_error(run.chapter->id + ": the simulation diverged at step " +
+                                 std::to_string(k + 1) + " (non-finite positions)");
+      if (k < warmup) continue;
+      ChapterResult& r = run.result;
+      const StepProfile& p = run.stepper->profile();
+      const auto s = phases(p);
+      for (std::size_t i = 0; i < s.size(); ++i) {
+        run.seconds[i].push_back(1e3 * s[i].seconds);
+        r.phase_allocations[i] = s[i].allocations;  // deterministic: the last step's
+      }
+      run.allocations.push_back(static_cast<double>(allocs));
+      r.allocations_max = std::max(r.allocations_max, allocs);
+      run.iterations.push_back(p.cg_iterations);
+      r.relative_residual = p.relative_residual;
+      r.not_converged_steps += p.converged ? 0 : 1;
     }
-    allocations.push_back(static_cast<double>(allocs));
-    r.allocations_max = std::max(r.allocations_max, allocs);
-    iterations.push_back(p.cg_iterations);
-    r.relative_residual = p.relative_residual;
-    r.not_converged_steps += p.converged ? 0 : 1;
+    if ((k + 1) % report_every == 0)
+      std::cout << "  step " << k + 1 << "/" << warmup + steps << " of every chapter\n" << std::flush;
   }
-  for (std::size_t i = 0; i < seconds.size(); ++i) r.ms[i] = spread(seconds[i]);
-  r.allocations_per_step = spread(allocations).median;
-  r.cg_iterations = spread(iterations).median;
-  return r;
+  std::vector<ChapterResult> results;
+  for (ChapterRun& run : runs) {
+    ChapterResult& r = run.result;
+    for (std::size_t i = 0; i < run.seconds.size(); ++i) r.ms[i] = spread(run.seconds[i]);
+    r.allocations_per_step = spread(run.allocations).median;
+    r.cg_iterations = spread(run.iterations).median;
+    if (r.not_converged_steps > 0)
+      std::cout << "  warning: " << r.chapter << ": " << r.not_converged_steps
+                << " steps stopped at the CG iteration cap\n";
+    results.push_back(r);
+  }
+  return results;
 }
 
 // The poster's solve table, on the same sequence of systems: the filtered systems of a
@@ -266,7 +295,8 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
   out << "  \"chapters\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const ChapterResult& r = results[i];
-    out << "    {\"chapter\": " << json_string(r.chapter) << ",\n"
+    out << "    {\"chapter\": " << json_string(r.chapter) << ", \"title\": " << json_string(r.title)
+        << ",\n"
         << "     \"median_ms\": " << spread_json(r.ms, &Spread::median) << ",\n"
         << "     \"min_ms\": " << spread_json(r.ms, &Spread::min) << ",\n"
         << "     \"q1_ms\": " << spread_json(r.ms, &Spread::q1) << ",\n"
@@ -374,16 +404,8 @@ int main(int argc, char** argv) {
               << cpu_model() << "\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
-    std::vector<ChapterResult> results;
-    for (const ChapterInfo* c : selected) {
-      std::cout << "  running " << c->id << " ..." << std::flush;
-      results.push_back(run_chapter(*c, scene, solver, warmup, steps));
-      std::cout << " step " << std::fixed << std::setprecision(3) << results.back().ms[5].median
-                << " ms" << std::defaultfloat << "\n";
-      if (results.back().not_converged_steps > 0)
-        std::cout << "    warning: " << results.back().not_converged_steps
-                  << " steps stopped at the CG iteration cap\n";
-    }
+    std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";
+    const std::vector<ChapterResult> results = run_chapters(selected, scene, solver, warmup, steps);
     print_table(results);
     std::vector<SolverResult> solvers;
     if (!args.has_flag("no-solvers")) {

@@ -120,26 +120,48 @@ def plot_solvers(data, out):
     finish(fig, data, out / "solvers.png")
 
 
+def spread_labels(ends, min_gap):
+    """Moves label heights (log10) apart by at least min_gap, keeping their order."""
+    ends = sorted(ends, key=lambda e: e[1])
+    placed = []
+    for x, y, label, color in ends:
+        ly = np.log10(y)
+        if placed and ly - placed[-1][1] < min_gap:
+            ly = placed[-1][1] + min_gap
+        placed.append((x, ly, y, label, color))
+    # Centre the stack on the line ends, so that it does not climb out of the axes.
+    shift = np.mean([np.log10(e[1]) for e in ends]) - np.mean([p[1] for p in placed])
+    return [(x, ly + shift, y, label, color) for x, ly, y, label, color in placed]
+
+
 def plot_scaling(data, out):
     runs = data["runs"]
-    fig, axes = plt.subplots(1, 2, figsize=(12, 5))
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
     chapters = sorted({r["chapter"] for r in runs})
+    stopped = {s["chapter"] for s in data.get("skipped", [])}
     for key, ax, title in (("step_ms", axes[0], "overall step"), ("solve_ms", axes[1], "solve")):
+        ends = []
         for c in chapters:
             pts = sorted((r["nodes"], r[key]) for r in runs if r["chapter"] == c)
             xs, ys = zip(*pts)
             line, = ax.plot(xs, ys, marker="o", ms=3)
-            ax.annotate(c, (xs[-1], ys[-1]), xytext=(4, 0), textcoords="offset points",
-                        fontsize=7, color=line.get_color(), va="center")
-            stopped = [s for s in data.get("skipped", []) if s["chapter"] == c]
-            if stopped:
-                ax.scatter([xs[-1]], [ys[-1]], marker="x", s=60, color=line.get_color(), zorder=3)
+            if c in stopped:
+                ax.scatter([xs[-1]], [ys[-1]], marker="x", s=70, color=line.get_color(), zorder=3)
+            ends.append((xs[-1], ys[-1], c + (" (stopped)" if c in stopped else ""), line.get_color()))
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("nodes")
-        ax.set_ylabel(f"median {title} time [ms]")
-        ax.set_title(f"{title.capitalize()} against mesh size (x: stopped, over budget)")
+        lo, hi = ax.get_ylim()
+        column = 1.5 * max(e[0] for e in ends)  # all labels in one column, right of the lines
+        for x, ly, y, label, color in spread_labels(ends, 0.05 * np.log10(hi / lo)):
+            ax.annotate(label, (x, y), xytext=(column, 10 ** ly), fontsize=7, color=color,
+                        va="center", arrowprops=dict(arrowstyle="-", color=color, lw=0.5))
+        ax.set_xlim(right=column * 8)
+        ax.set_xlabel("nodes (log)")
+        ax.set_ylabel(f"median {title} time per step [ms] (log)")
+        ax.set_title(f"{title.capitalize()} against mesh size")
         ax.grid(which="both", alpha=0.3)
+    fig.suptitle(f"Scaling over the beam series (x: the next size went over the "
+                 f"{data.get('budget_seconds', '?')} s budget per run)", fontsize=10)
     finish(fig, data, out / "scaling.png")
 
 

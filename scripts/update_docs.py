@@ -130,6 +130,26 @@ def headline(data):
             f"{b['compiler']} `{b['flags']}`, commit {data['commit']}.\n")
 
 
+def chapter_map(data):
+    """One line per chapter: the idea, the phase it moves most, the overall step speedup."""
+    by = chapters_by_name(data)
+    base = by.get(BASELINE)
+    rows, previous = [], None
+    for c in data["chapters"]:
+        name = c["chapter"]
+        moved = "the baseline"
+        if previous is not None:
+            phase = max(PHASES[:-1], key=lambda p: previous["median_ms"][p] / max(c["median_ms"][p], 1e-9))
+            moved = (f"{PHASE_LABELS[phase]} {ratio(previous['median_ms'][phase], c['median_ms'][phase])} "
+                     f"over `{previous['chapter']}`")
+        diff = f"[diff](docs/diffs/{name}.diff)" if previous is not None else ""
+        rows.append([f"[`{name}`](chapters/{name}/README.md)", c.get("title", ""), moved,
+                     ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-", diff])
+        previous = c
+    return table(["chapter", "the idea", "the phase it moves most", "step speedup over 01", "diff"],
+                 rows, ["---", "---", "---", "---:", "---"])
+
+
 def chapter_table(data, name):
     by = chapters_by_name(data)
     c = by[name]
@@ -196,7 +216,7 @@ def main():
         "results:machine": machine_table(data), "results:phases": phases_table(data),
         "results:speedups": speedups_table(data), "results:allocations": allocations_table(data),
         "results:solvers": solvers, "results:scaling": scaling_table(scaling)})
-    update_file(root / "README.md", {"headline": headline(data)})
+    update_file(root / "README.md", {"headline": headline(data), "chapter-map": chapter_map(data)})
     for c in data["chapters"]:
         update_file(root / "chapters" / c["chapter"] / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),

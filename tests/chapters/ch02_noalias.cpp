@@ -9,20 +9,12 @@
 using namespace fem;
 
 TEST_CASE("ch02: matches chapter 01 on both scenes over 50 steps", "[ch02]") {
-  for (const char* name : {"cantilever", "sliding"}) {
-    const test::Drift d = test::drift_from_ch01("02", test::test_scene(name), 50);
-    INFO(name << ": max |dx| " << d.x << " of motion " << d.motion << ", max |dv| " << d.v
-              << " of speed " << d.speed);
-    REQUIRE(d.motion > 1e-3);
-    CHECK(d.relative() < 1e-8);
-  }
+  for (const char* name : {"cantilever", "sliding"})
+    test::check_matches_ch01("02", test::test_scene(name));
 }
 
 TEST_CASE("ch02: allocates strictly fewer per step than chapter 01", "[ch02][alloc]") {
-  if (!alloc::enabled()) {
-    SUCCEED("allocation counting is off in sanitizer builds");
-    return;
-  }
+  FEM_REQUIRE_ALLOCATION_COUNTER();
   for (const char* name : {"cantilever", "sliding"}) {
     const Scene scene = test::test_scene(name);
     const long long ch01 = test::allocations_per_step("01", scene);
@@ -35,10 +27,7 @@ TEST_CASE("ch02: allocates strictly fewer per step than chapter 01", "[ch02][all
 }
 
 TEST_CASE("ch02: every rewritten statement allocates less than the original", "[ch02][alloc]") {
-  if (!alloc::enabled()) {
-    SUCCEED("allocation counting is off in sanitizer builds");
-    return;
-  }
+  FEM_REQUIRE_ALLOCATION_COUNTER();
   const auto counts = ch02::count_statements(test::test_scene("sliding"));
   REQUIRE(counts.size() == 5);
   for (const auto& c : counts) {
