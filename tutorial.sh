@@ -31,8 +31,8 @@ commands:
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
-             the README and the chapter READMEs, plots copied to docs/images/) and the lesson
-             tables (fem_lessons); run bench (and scaling) first
+             the README and the chapter READMEs, plots copied to docs/images/), the lesson
+             tables (fem_lessons) and the chapter diffs (docs/diffs/); run bench (and scaling) first
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
@@ -135,6 +135,8 @@ docs() {
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   log "results tables and plots"
   "$VENV/bin/python" scripts/update_docs.py --images docs/images
+  log "chapter diffs (docs/diffs/)"
+  "$VENV/bin/python" scripts/chapter_diffs.py
 }
 
 sim() {
@@ -152,21 +154,27 @@ meshes() {
   "$VENV/bin/python" meshes/generate.py "$@"
 }
 
-cmd="${1:-help}"
-[ $# -gt 0 ] && shift
-case "$cmd" in
-  setup) setup ;;
-  build) build ;;
-  test) run_tests "$@" ;;
-  bench) bench "$@" ;;
-  scaling) scaling "$@" ;;
-  docs) docs ;;
-  sim) sim "$@" ;;
-  meshes) meshes "$@" ;;
-  help | --help | -h) usage ;;
-  *)
-    echo "tutorial.sh: unknown command '$cmd'" >&2
-    usage >&2
-    exit 2
-    ;;
-esac
+main() {
+  cmd="${1:-help}"
+  [ $# -gt 0 ] && shift
+  case "$cmd" in
+    setup) setup ;;
+    build) build ;;
+    test) run_tests "$@" ;;
+    bench) bench "$@" ;;
+    scaling) scaling "$@" ;;
+    docs) docs ;;
+    sim) sim "$@" ;;
+    meshes) meshes "$@" ;;
+    help | --help | -h) usage ;;
+    *)
+      echo "tutorial.sh: unknown command '$cmd'" >&2
+      usage >&2
+      exit 2
+      ;;
+  esac
+}
+
+# Parsed whole before it runs: editing this file while it runs cannot derail it.
+main "$@"
+exit $?

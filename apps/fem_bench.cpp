@@ -227,7 +227,7 @@ void print_solvers(const std::vector<SolverResult>& solvers) {
 }
 
 std::string git_commit() {
-  const std::string cmd = "git -C '" + source_dir() + "' rev-parse --short HEAD 2>/dev/null";
+  const std::string cmd = "git -C '" + source_dir() + "' describe --always --dirty --abbrev=7 2>/dev/null";
   std::string out;
   if (FILE* pipe = popen(cmd.c_str(), "r")) {
     char buf[64];

@@ -18,7 +18,13 @@ int main(int argc, char** argv) {
   args.option("out", "DIR", "directory for the .vtu frames and the .pvd series", "out/sim");
   try {
     if (!args.parse(argc, argv)) return 0;
-    const ChapterInfo& chapter = find_chapter(args.get("chapter"));
+    const ChapterInfo* found = nullptr;
+    try {
+      found = &find_chapter(args.get("chapter"));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    const ChapterInfo& chapter = *found;
     const int steps = args.get_int("steps");
     const int every = args.get_int("every");
     if (steps <= 0) throw UsageError("--steps must be positive");

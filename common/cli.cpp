@@ -152,7 +152,14 @@ Scene scene_from_args(const ArgParser& args) {
   for (const auto& s : scene_names()) known = known || s == name;
   if (!known) throw UsageError("unknown scene '" + name + "' (known: cantilever, sliding)");
 
-  Scene scene = make_scene(name, load_mesh(resolve_mesh_path(args.get("mesh"))), m);
+  TetMesh mesh = load_mesh(resolve_mesh_path(args.get("mesh")));
+  if (mesh.reoriented_tets > 0)
+    std::cerr << "note: " << mesh.file << ": " << mesh.reoriented_tets
+              << " inverted tetrahedra were reoriented on load\n";
+  if (mesh.dropped_nodes > 0)
+    std::cerr << "note: " << mesh.file << ": " << mesh.dropped_nodes
+              << " nodes used by no tetrahedron were dropped\n";
+  Scene scene = make_scene(name, std::move(mesh), m);
   scene.dt = dt;
   scene.damping = {alpha, beta};
   validate(scene);
