@@ -1,20 +1,19 @@
 // fem_bench: measures every chapter on the same scene and mesh, in one process so that
 // the ratios between chapters hold while the machine's speed drifts. Prints the
 // per-phase table (median ms, allocations per step) and writes it as JSON.
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <array>
-#include <cstdio>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <sstream>
-
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCholesky>
 
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "chapters/registry.hpp"
@@ -26,8 +25,8 @@ namespace {
 
 using namespace fem;
 
-constexpr std::array<const char*, 6> kPhases = {"forces", "dfdx", "compose", "constraints",
-                                                "solve", "step"};
+constexpr std::array<const char*, 6> kPhases = {"forces",      "dfdx",  "compose",
+                                                "constraints", "solve", "step"};
 
 std::array<PhaseCost, 6> phases(const StepProfile& p) {
   return {p.forces, p.dfdx, p.compose, p.constraints, p.solve, p.step};
@@ -52,11 +51,11 @@ Spread spread(std::vector<double> v) {
 struct ChapterResult {
   std::string chapter;
   std::string title;
-  std::array<Spread, 6> ms;  // per phase, milliseconds
-  double allocations_per_step;  // median over the measured steps
+  std::array<Spread, 6> ms;                    // per phase, milliseconds
+  double allocations_per_step;                 // median over the measured steps
   std::array<long long, 6> phase_allocations;  // per phase, the last measured step
   long long allocations_max;
-  double cg_iterations;  // median
+  double cg_iterations;      // median
   double relative_residual;  // last step
   int not_converged_steps;
 };
@@ -79,7 +78,12 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                                         int warmup, int steps) {
   std::vector<ChapterRun> runs;
   for (const ChapterInfo* c : chapters)
-    runs.push_back({c, c->make(scene, solver), rest_state(scene), {}, {}, {},
+    runs.push_back({c,
+                    c->make(scene, solver),
+                    rest_state(scene),
+                    {},
+                    {},
+                    {},
                     ChapterResult{c->id, c->title, {}, 0.0, {}, 0, 0.0, 0.0, 0}});
   const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
@@ -105,7 +109,8 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
       r.not_converged_steps += p.converged ? 0 : 1;
     }
     if ((k + 1) % report_every == 0)
-      std::cout << "  step " << k + 1 << "/" << warmup + steps << " of every chapter\n" << std::flush;
+      std::cout << "  step " << k + 1 << "/" << warmup + steps << " of every chapter\n"
+                << std::flush;
   }
   std::vector<ChapterResult> results;
   for (ChapterRun& run : runs) {
@@ -135,8 +140,8 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   struct Samples {
     std::vector<double> ms, iterations, allocations;
   };
-  const std::vector<std::string> names = {"eigen_cg",       "eigen_cg_guess", "pcg_ch06",
-                                          "eigen_cg_full",  "eigen_cg_ichol", "eigen_ldlt"};
+  const std::vector<std::string> names = {"eigen_cg",      "eigen_cg_guess", "pcg_ch06",
+                                          "eigen_cg_full", "eigen_cg_ichol", "eigen_ldlt"};
   std::vector<Samples> samples(names.size());
   ch06::CustomPcgStepper stepper(scene, settings);
   State state = rest_state(scene);
@@ -145,7 +150,8 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   Eigen::ConjugateGradient<SparseMatrix> cg;
   Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper> cg_full;
   Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
-                           Eigen::IncompleteCholesky<double>> cg_ichol;
+                           Eigen::IncompleteCholesky<double>>
+      cg_ichol;
   Eigen::SimplicialLDLT<SparseMatrix> ldlt;
   const auto configure = [&settings](auto& solver) {
     solver.setTolerance(settings.tolerance);  // Eigen's default is machine epsilon
@@ -227,7 +233,8 @@ void print_solvers(const std::vector<SolverResult>& solvers) {
 }
 
 std::string git_commit() {
-  const std::string cmd = "git -C '" + source_dir() + "' describe --always --dirty --abbrev=7 2>/dev/null";
+  const std::string cmd =
+      "git -C '" + source_dir() + "' describe --always --dirty --abbrev=7 2>/dev/null";
   std::string out;
   if (FILE* pipe = popen(cmd.c_str(), "r")) {
     char buf[64];
@@ -287,7 +294,8 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
   out << "  \"cg_tolerance\": " << solver.tolerance
       << ",\n  \"cg_max_iterations\": " << solver.max_iterations << ",\n";
   out << "  \"build\": {\"compiler\": " << json_string(b.compiler)
-      << ", \"flags\": " << json_string(b.flags) << ", \"build_type\": " << json_string(b.build_type)
+      << ", \"flags\": " << json_string(b.flags)
+      << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
       << ", \"threads\": " << hardware_threads() << "},\n";
@@ -325,10 +333,12 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
 }
 
 void print_table(const std::vector<ChapterResult>& results) {
-  std::cout << "\nmedian ms per step (forces = rotations + element forces, the same code in every chapter)\n";
+  std::cout << "\nmedian ms per step (forces = rotations + element forces, the same code in every "
+               "chapter)\n";
   std::cout << std::left << std::setw(26) << "chapter" << std::right;
   for (const char* p : kPhases) std::cout << std::setw(12) << p;
-  std::cout << std::setw(13) << "allocs/step" << std::setw(8) << "CG it" << std::setw(11) << "rel.res.\n";
+  std::cout << std::setw(13) << "allocs/step" << std::setw(8) << "CG it" << std::setw(11)
+            << "rel.res.\n";
   for (const auto& r : results) {
     std::cout << std::left << std::setw(26) << r.chapter << std::right << std::fixed
               << std::setprecision(3);
@@ -398,8 +408,8 @@ int main(int argc, char** argv) {
     const BuildInfo b = build_info();
     std::cout << "fem_bench: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
               << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), dt "
-              << scene.dt << " s, " << warmup << " warm-up + " << steps << " measured steps, CG tol "
-              << solver.tolerance << "\n"
+              << scene.dt << " s, " << warmup << " warm-up + " << steps
+              << " measured steps, CG tol " << solver.tolerance << "\n"
               << "build: " << b.compiler << ", " << b.flags << ", Eigen " << b.eigen << "; CPU "
               << cpu_model() << "\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";

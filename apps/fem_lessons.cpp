@@ -70,7 +70,8 @@ double set_from_triplets_ms(const Scene& scene, int steps) {
         }
     }
     dfdx.setFromTriplets(triplets.begin(), triplets.end());  // sorts, sums duplicates, allocates
-    ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ms.push_back(1e3 *
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return median(ms);
 }
@@ -113,7 +114,8 @@ double time_ms(int repeat, F&& f) {
   for (int k = 0; k < repeat; ++k) {
     const auto start = std::chrono::steady_clock::now();
     f();
-    ms.push_back(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    ms.push_back(1e3 *
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return median(ms);
 }

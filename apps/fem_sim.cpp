@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "done in " << seconds << " s";
-    if (every > 0) std::cout << "; " << series.frames() << " frames, open " << series.pvd_path() << " in ParaView";
+    if (every > 0)
+      std::cout << "; " << series.frames() << " frames, open " << series.pvd_path()
+                << " in ParaView";
     std::cout << "\n";
   } catch (const UsageError& e) {
     std::cerr << "fem_sim: " << e.what() << " (see fem_sim --help)\n";

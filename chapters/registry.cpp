@@ -26,9 +26,12 @@ const std::vector<ChapterInfo>& chapters() {
   static const std::vector<ChapterInfo> list = {
       chapter<ch01::NaiveStepper>("01_naive", "Eigen as the documentation suggests"),
       chapter<ch02::NoAliasStepper>("02_noalias", "no hidden temporaries in assignments"),
-      chapter<ch03::IndexedAccessStepper>("03_indexed_access", "df/dx through a table of value offsets"),
-      chapter<ch04::SystemCompositionStepper>("04_system_composition", "A and b in one pass over shared value arrays"),
-      chapter<ch05::InplaceConstraintsStepper>("05_inplace_constraints", "S A S^T applied in place, no S"),
+      chapter<ch03::IndexedAccessStepper>("03_indexed_access",
+                                          "df/dx through a table of value offsets"),
+      chapter<ch04::SystemCompositionStepper>("04_system_composition",
+                                              "A and b in one pass over shared value arrays"),
+      chapter<ch05::InplaceConstraintsStepper>("05_inplace_constraints",
+                                               "S A S^T applied in place, no S"),
       chapter<ch06::CustomPcgStepper>("06_custom_pcg", "our own PCG: warm start, no allocations"),
       chapter<ch07::BlockSparseStepper>("07_block_sparse", "3x3 block sparse matrix, block Jacobi"),
   };

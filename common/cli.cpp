@@ -89,7 +89,8 @@ int ArgParser::get_int(const std::string& name) const {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != s.size()) throw UsageError("--" + name + " expects an integer, got '" + s + "'");
+  if (used == 0 || used != s.size())
+    throw UsageError("--" + name + " expects an integer, got '" + s + "'");
   return v;
 }
 
@@ -125,7 +126,8 @@ void add_scene_options(ArgParser& args, const std::string& default_mesh) {
 
 std::string resolve_mesh_path(const std::string& path) {
   namespace fs = std::filesystem;
-  if (fs::path(path).is_relative() && !fs::exists(path) && fs::exists(fs::path(source_dir()) / path))
+  if (fs::path(path).is_relative() && !fs::exists(path) &&
+      fs::exists(fs::path(source_dir()) / path))
     return (fs::path(source_dir()) / path).string();
   return path;
 }
@@ -168,7 +170,8 @@ Scene scene_from_args(const ArgParser& args) {
 
 void add_solver_options(ArgParser& args) {
   const SolverSettings s;
-  args.option("tol", "REL", "CG relative residual tolerance, in (0, 1)", format_number(s.tolerance));
+  args.option("tol", "REL", "CG relative residual tolerance, in (0, 1)",
+              format_number(s.tolerance));
   args.option("max-iters", "N", "CG iteration cap, > 0", std::to_string(s.max_iterations));
 }
 

@@ -48,8 +48,7 @@ Vector12d element_force(const ElementRest& rest, const Eigen::Matrix3d& R, const
 double element_energy(const ElementRest& rest, const Lame& lame, const Vector12d& x);
 
 // Block (a, b) of the warped stiffness df/dx_e = -R K0 R^T (a, b in 0..3).
-inline Eigen::Matrix3d dfdx_block(const ElementRest& rest, const Eigen::Matrix3d& R, int a,
-                                  int b) {
+inline Eigen::Matrix3d dfdx_block(const ElementRest& rest, const Eigen::Matrix3d& R, int a, int b) {
   return -R * rest.K0.block<3, 3>(3 * a, 3 * b) * R.transpose();
 }
 

@@ -56,7 +56,8 @@ void reset_gmsh() {
 }  // namespace
 
 TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const std::string& name) {
-  if (tets.empty()) fail(name, "no tetrahedra (a file whose only physical group is a surface saves none)");
+  if (tets.empty())
+    fail(name, "no tetrahedra (a file whose only physical group is a surface saves none)");
   if (!X.allFinite()) {
     Eigen::Index bad = 0;
     while (X.col(bad).allFinite()) ++bad;

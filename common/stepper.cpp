@@ -11,8 +11,8 @@ void report_if_not_converged(const StepProfile& profile, const SolverSettings& s
   if (profile.converged || already_warned) return;
   already_warned = true;
   std::cerr << "warning: " << chapter << ": the linear solve stopped at the iteration cap ("
-            << settings.max_iterations << ") with relative residual "
-            << profile.relative_residual << " > tolerance " << settings.tolerance
+            << settings.max_iterations << ") with relative residual " << profile.relative_residual
+            << " > tolerance " << settings.tolerance
             << " (reported once; see StepProfile::converged for every step)\n";
 }
 

@@ -32,7 +32,7 @@ struct StepProfile {
 // Conjugate gradient settings, the same for every chapter so that timings compare.
 // Eigen's default tolerance is machine epsilon: always set it explicitly.
 struct SolverSettings {
-  double tolerance = 1e-4;   // relative residual ||r|| <= tolerance * ||rhs||
+  double tolerance = 1e-4;  // relative residual ||r|| <= tolerance * ||rhs||
   int max_iterations = 2000;
 };
 

@@ -2,9 +2,8 @@
 // running a stepper for a number of steps.
 #pragma once
 
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <string>
 
 #include "chapters/registry.hpp"
@@ -45,8 +44,8 @@ namespace fem::test {
 
 // How far a chapter drifts from chapter 01 when both run the same scene side by side.
 struct Drift {
-  double x = 0.0, v = 0.0;              // max |x - x01|, max |v - v01| over all steps
-  double motion = 0.0, speed = 0.0;     // max |x01 - X|, max |v01|: the scale of the motion
+  double x = 0.0, v = 0.0;           // max |x - x01|, max |v - v01| over all steps
+  double motion = 0.0, speed = 0.0;  // max |x01 - X|, max |v01|: the scale of the motion
   double relative() const { return std::max(x / motion, v / speed); }
 };
 
@@ -120,8 +119,8 @@ inline void check_matches_ch01(const std::string& chapter, const Scene& scene) {
 }  // namespace fem::test
 
 // Allocation tests skip (and say so) where the counter is off: the sanitizer builds.
-#define FEM_REQUIRE_ALLOCATION_COUNTER()                           \
-  if (!fem::alloc::enabled()) {                                    \
-    SUCCEED("allocation counting is off in sanitizer builds");    \
-    return;                                                        \
+#define FEM_REQUIRE_ALLOCATION_COUNTER()                       \
+  if (!fem::alloc::enabled()) {                                \
+    SUCCEED("allocation counting is off in sanitizer builds"); \
+    return;                                                    \
   }

@@ -92,7 +92,8 @@ inline std::vector<StatementCount> count_statements(const Scene& scene) {
   // The triplet list of S: a local vector grows by doubling every step.
   add(FEM_STATEMENT(std::vector<Eigen::Triplet<double>> s;
                     for (int k = 0; k < n; ++k) s.emplace_back(k, k, 1.0)),
-      FEM_STATEMENT(triplets.clear(); for (int k = 0; k < n; ++k) triplets.emplace_back(k, k, 1.0)));
+      FEM_STATEMENT(triplets.clear();
+                    for (int k = 0; k < n; ++k) triplets.emplace_back(k, k, 1.0)));
   return out;
 }
 

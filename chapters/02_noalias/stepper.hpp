@@ -50,7 +50,7 @@ class NoAliasStepper final : public Stepper {
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;                 // (h + beta) v, then b - A z
+  Eigen::VectorXd tmp_;  // (h + beta) v, then b - A z
   std::vector<Eigen::Triplet<double>> s_triplets_;
   std::vector<bool> constrained_;
   Eigen::SparseMatrix<double> identity_;

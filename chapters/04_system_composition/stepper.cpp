@@ -15,7 +15,8 @@ namespace fem::ch04 {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 
-SystemCompositionStepper::SystemCompositionStepper(const Scene& scene, const SolverSettings& settings)
+SystemCompositionStepper::SystemCompositionStepper(const Scene& scene,
+                                                   const SolverSettings& settings)
     : scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());

@@ -43,14 +43,14 @@ class SystemCompositionStepper final : public Stepper {
   StepProfile profile_;
   bool warned_not_converged_ = false;
 
-  std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
-  Eigen::VectorXd f_;                       // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;       // the sparse interaction forces
-  Eigen::SparseMatrix<double> dfdx_;        // pattern of the mesh connectivity, allocated once
+  std::vector<Eigen::Matrix3d> rotations_;   // R_e of the polar decomposition, per element
+  Eigen::VectorXd f_;                        // elastic forces + gravity
+  Eigen::SparseVector<double> f_ext_;        // the sparse interaction forces
+  Eigen::SparseMatrix<double> dfdx_;         // pattern of the mesh connectivity, allocated once
   std::vector<BlockOffsets> block_offsets_;  // per element, built once with the pattern
-  Eigen::SparseMatrix<double> A_;           // M - h df/dv - h^2 df/dx, the pattern of dfdx_
-  std::vector<int> diagonal_offsets_;       // where entry (k, k) sits in the value arrays
-  Eigen::VectorXd b_;                       // h (f + h df/dx v)
+  Eigen::SparseMatrix<double> A_;            // M - h df/dv - h^2 df/dx, the pattern of dfdx_
+  std::vector<int> diagonal_offsets_;        // where entry (k, k) sits in the value arrays
+  Eigen::VectorXd b_;                        // h (f + h df/dx v)
   Eigen::SparseMatrix<double> S_;           // the constraint filter, 3x3 blocks S_i on the diagonal
   Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
   Eigen::SparseMatrix<double> filtered_A_;  // S A S^T + I - S
@@ -58,7 +58,7 @@ class SystemCompositionStepper final : public Stepper {
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;                 // (h + beta) v, then b - A z
+  Eigen::VectorXd tmp_;  // (h + beta) v, then b - A z
   std::vector<Eigen::Triplet<double>> s_triplets_;
   std::vector<bool> constrained_;
   Eigen::SparseMatrix<double> identity_;

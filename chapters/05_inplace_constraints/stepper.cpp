@@ -15,7 +15,8 @@ namespace fem::ch05 {
 using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 
-InplaceConstraintsStepper::InplaceConstraintsStepper(const Scene& scene, const SolverSettings& settings)
+InplaceConstraintsStepper::InplaceConstraintsStepper(const Scene& scene,
+                                                     const SolverSettings& settings)
     : scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());

@@ -35,8 +35,8 @@ class InplaceConstraintsStepper final : public Stepper {
   void build_dfdx();
   void build_block_rows();
   // The 3x3 block of a matrix with the pattern of dfdx_: block k of column block j.
-  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>> block(Eigen::SparseMatrix<double>& m,
-                                                             int j, int k) const;
+  Eigen::Map<Eigen::Matrix3d, 0, Eigen::OuterStride<>> block(Eigen::SparseMatrix<double>& m, int j,
+                                                             int k) const;
   void compose_system(const State& state);
   void apply_constraints(const State& state);
   void solve();
@@ -47,26 +47,26 @@ class InplaceConstraintsStepper final : public Stepper {
   StepProfile profile_;
   bool warned_not_converged_ = false;
 
-  std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
-  Eigen::VectorXd f_;                       // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;       // the sparse interaction forces
-  Eigen::SparseMatrix<double> dfdx_;        // pattern of the mesh connectivity, allocated once
+  std::vector<Eigen::Matrix3d> rotations_;   // R_e of the polar decomposition, per element
+  Eigen::VectorXd f_;                        // elastic forces + gravity
+  Eigen::SparseVector<double> f_ext_;        // the sparse interaction forces
+  Eigen::SparseMatrix<double> dfdx_;         // pattern of the mesh connectivity, allocated once
   std::vector<BlockOffsets> block_offsets_;  // per element, built once with the pattern
-  Eigen::SparseMatrix<double> A_;           // M - h df/dv - h^2 df/dx, the pattern of dfdx_
-  std::vector<int> diagonal_offsets_;       // where entry (k, k) sits in the value arrays
-  Eigen::VectorXd b_;                       // h (f + h df/dx v)
-  Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
-  Eigen::VectorXd filtered_b_;              // S (b - A z)
+  Eigen::SparseMatrix<double> A_;            // M - h df/dv - h^2 df/dx, the pattern of dfdx_
+  std::vector<int> diagonal_offsets_;        // where entry (k, k) sits in the value arrays
+  Eigen::VectorXd b_;                        // h (f + h df/dx v)
+  Eigen::VectorXd z_;                        // prescribed velocity change of constrained dofs
+  Eigen::VectorXd filtered_b_;               // S (b - A z)
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;                 // (h + beta) v
+  Eigen::VectorXd tmp_;  // (h + beta) v
 
   // The block structure of the pattern, built once. Column block j (the columns of node j)
   // holds one 3x3 block per neighbour i, in order; block k starts at row 3 * (its k-th
   // neighbour) of each of the three columns, column_stride_[j] = 3 * neighbours apart.
   std::vector<int> column_stride_;
-  std::vector<int> diagonal_block_;     // k of the diagonal block (j, j) in column block j
+  std::vector<int> diagonal_block_;  // k of the diagonal block (j, j) in column block j
   // Row blocks of node i, i.e. blocks (i, j): column block j and position k, CSR-like.
   std::vector<int> row_block_start_;
   std::vector<std::pair<int, int>> row_blocks_;

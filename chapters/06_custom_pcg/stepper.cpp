@@ -5,12 +5,11 @@
 // Chapter 06 changes only the solve: our own PCG, warm-started, allocation-free.
 #include "chapters/06_custom_pcg/stepper.hpp"
 
-#include <cmath>
-#include <limits>
-
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include <stdexcept>
 
 namespace fem::ch06 {
@@ -242,7 +241,8 @@ std::vector<int> diagonal_offsets(const Eigen::SparseMatrix<double>& A) {
   std::vector<int> offsets(static_cast<std::size_t>(A.cols()));
   const int* inner = A.innerIndexPtr();
   for (int k = 0; k < A.cols(); ++k) {
-    const int* first = std::lower_bound(inner + A.outerIndexPtr()[k], inner + A.outerIndexPtr()[k + 1], k);
+    const int* first =
+        std::lower_bound(inner + A.outerIndexPtr()[k], inner + A.outerIndexPtr()[k + 1], k);
     offsets[k] = static_cast<int>(first - inner);
   }
   return offsets;

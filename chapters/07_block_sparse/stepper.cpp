@@ -141,7 +141,8 @@ void BlockSparseStepper::build_dfdx() {
   for (auto& block : dfdx_.blocks) block.setZero();
   for (std::size_t e = 0; e < model_.tets.size(); ++e)
     for (int ab = 0; ab < 16; ++ab)
-      dfdx_.blocks[element_blocks_[e][ab]] += dfdx_block(model_.rest[e], rotations_[e], ab / 4, ab % 4);
+      dfdx_.blocks[element_blocks_[e][ab]] +=
+          dfdx_block(model_.rest[e], rotations_[e], ab / 4, ab % 4);
 }
 
 void BlockSparseStepper::compose_system(const State& state) {

@@ -81,19 +81,19 @@ class BlockSparseStepper final : public Stepper {
   StepProfile profile_;
   bool warned_not_converged_ = false;
 
-  std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
-  Eigen::VectorXd f_;                       // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;       // the sparse interaction forces
-  BlockSparseMatrix dfdx_;                  // pattern of the mesh connectivity, built once
+  std::vector<Eigen::Matrix3d> rotations_;           // R_e of the polar decomposition, per element
+  Eigen::VectorXd f_;                                // elastic forces + gravity
+  Eigen::SparseVector<double> f_ext_;                // the sparse interaction forces
+  BlockSparseMatrix dfdx_;                           // pattern of the mesh connectivity, built once
   std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b)
-  BlockSparseMatrix A_;                     // M - h df/dv - h^2 df/dx, the pattern of dfdx_
-  std::vector<int> diagonal_block_;         // per node: index of block (i, i)
-  std::vector<int> transpose_block_;        // per block (i, j): index of block (j, i)
-  Eigen::VectorXd b_;                       // h (f + h df/dx v)
-  Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
-  Eigen::VectorXd filtered_b_;              // S (b - A z)
+  BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the pattern of dfdx_
+  std::vector<int> diagonal_block_;   // per node: index of block (i, i)
+  std::vector<int> transpose_block_;  // per block (i, j): index of block (j, i)
+  Eigen::VectorXd b_;                 // h (f + h df/dx v)
+  Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
+  Eigen::VectorXd filtered_b_;        // S (b - A z)
   Eigen::VectorXd dv_;
-  Eigen::VectorXd tmp_;                     // (h + beta) v
+  Eigen::VectorXd tmp_;  // (h + beta) v
   PcgWorkspace pcg_;
   Eigen::VectorXd y_;  // the unknown of the filtered system, dv = y + z: also the warm start
 };

@@ -22,8 +22,8 @@ Scene every_filter_case() {
 }  // namespace
 
 TEST_CASE("ch05: matches chapter 01 on both scenes over 50 steps", "[ch05]") {
-  for (const Scene& scene : {test::test_scene("cantilever"), test::test_scene("sliding"),
-                             every_filter_case()})
+  for (const Scene& scene :
+       {test::test_scene("cantilever"), test::test_scene("sliding"), every_filter_case()})
     test::check_matches_ch01("05", scene);
 }
 
@@ -66,7 +66,8 @@ TEST_CASE("ch05: composition and constraints allocate nothing", "[ch05][alloc]")
       stepper.step(state);
       const StepProfile& p = stepper.profile();
       INFO(scene.name << " step " << k << ": constraints " << p.constraints.allocations
-                      << ", compose " << p.compose.allocations << ", solve " << p.solve.allocations);
+                      << ", compose " << p.compose.allocations << ", solve "
+                      << p.solve.allocations);
       if (k == 0) continue;  // the first step sizes the work vectors
       CHECK(p.dfdx.allocations == 0);
       CHECK(p.compose.allocations == 0);

@@ -48,8 +48,7 @@ TEST_CASE("ch06: pcg_solve reaches the requested tolerance on an SPD system", "[
   }
 }
 
-TEST_CASE("ch06: with a filtered singular system the constrained components are exact",
-          "[ch06]") {
+TEST_CASE("ch06: with a filtered singular system the constrained components are exact", "[ch06]") {
   // A singular matrix (a free-floating body has rigid modes) made SPD by the filter:
   // fixed node 0 and a plane-constrained node 1 pin it. The filtered solve must return
   // y with exactly zero constrained components, so that dv = y + z has exactly z there.
@@ -66,7 +65,8 @@ TEST_CASE("ch06: with a filtered singular system the constrained components are 
                                       test::tight_solver(), work, y);
   REQUIRE(result.converged);
   for (const auto& c : scene.constraints) {
-    const Eigen::Vector3d constrained = (Eigen::Matrix3d::Identity() - c.filter) * y.segment<3>(3 * c.node);
+    const Eigen::Vector3d constrained =
+        (Eigen::Matrix3d::Identity() - c.filter) * y.segment<3>(3 * c.node);
     CHECK(constrained.norm() <= 1e-15 * y.norm());
   }
   // And it is the solution: compare with a dense Cholesky of the same system.

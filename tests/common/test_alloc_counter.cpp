@@ -15,10 +15,10 @@ void escape(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
 
 }  // namespace
 
-#define REQUIRE_COUNTER_ON()                                          \
-  if (!alloc::enabled()) {                                            \
-    SUCCEED("allocation counting is off in sanitizer builds");       \
-    return;                                                           \
+#define REQUIRE_COUNTER_ON()                                   \
+  if (!alloc::enabled()) {                                     \
+    SUCCEED("allocation counting is off in sanitizer builds"); \
+    return;                                                    \
   }
 
 TEST_CASE("a std::vector reserve is one allocation", "[alloc]") {

@@ -36,7 +36,8 @@ Deflection static_deflection(const std::string& file) {
     REQUIRE(stepper->profile().converged);
     if ((state.x - before).cwiseAbs().maxCoeff() < 1e-12) break;
   }
-  const Eigen::Vector3d lo = scene.mesh.X.rowwise().minCoeff(), hi = scene.mesh.X.rowwise().maxCoeff();
+  const Eigen::Vector3d lo = scene.mesh.X.rowwise().minCoeff(),
+                        hi = scene.mesh.X.rowwise().maxCoeff();
   const double L = hi.x() - lo.x(), b = hi.y() - lo.y(), h = hi.z() - lo.z();
   double tip = 0.0;
   int count = 0;
@@ -59,8 +60,8 @@ TEST_CASE("clamped beam deflection converges to Euler-Bernoulli with refinement"
        {"beam_500.msh", "beam_1k.msh", "beam_2k.msh", "beam_5k.msh", "beam_10k.msh"}) {
     series.push_back(static_deflection(file));
     const Deflection& d = series.back();
-    std::cout << "beam " << d.nodes << " nodes: FEM " << d.fem << " m, Euler-Bernoulli "
-              << d.theory << " m, ratio " << d.fem / d.theory << "\n";
+    std::cout << "beam " << d.nodes << " nodes: FEM " << d.fem << " m, Euler-Bernoulli " << d.theory
+              << " m, ratio " << d.fem / d.theory << "\n";
     CHECK(d.fem > 0.0);
     CHECK(d.fem < 1.05 * d.theory);  // shear (Timoshenko) adds < 1% at L/h = 10
   }

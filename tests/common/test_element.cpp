@@ -13,7 +13,7 @@ const Lame kLame = lame_from_young_poisson(1e5, 0.3);
 
 Vector12d rest_positions() {
   Vector12d X;
-  X << 0.1, 0.0, 0.0,  1.0, 0.1, 0.0,  0.0, 1.1, 0.1,  0.2, 0.1, 0.9;
+  X << 0.1, 0.0, 0.0, 1.0, 0.1, 0.0, 0.0, 1.1, 0.1, 0.2, 0.1, 0.9;
   return X;
 }
 
@@ -98,8 +98,7 @@ TEST_CASE("element force is minus the energy gradient (finite differences)", "[e
   CHECK(best < 1e-7);
 }
 
-TEST_CASE("warped stiffness -R K0 R^T is the force Jacobian of a rotated rest shape",
-          "[element]") {
+TEST_CASE("warped stiffness -R K0 R^T is the force Jacobian of a rotated rest shape", "[element]") {
   const ElementRest rest = make_element_rest(rest_positions(), kLame);
   const Vector12d x =
       transform(rest.X, some_rotation(), Eigen::Matrix3d::Zero(), Eigen::Vector3d(1.0, 2.0, 3.0));
@@ -120,8 +119,8 @@ TEST_CASE("warped stiffness leaves out dR/dx: its error grows linearly with the 
   // term is proportional to the strain: ten times the strain, ten times the error.
   const ElementRest rest = make_element_rest(rest_positions(), kLame);
   const auto relative_error = [&](double strain) {
-    const Vector12d x = transform(rest.X, some_rotation(), some_deformation(strain),
-                                  Eigen::Vector3d::Zero());
+    const Vector12d x =
+        transform(rest.X, some_rotation(), some_deformation(strain), Eigen::Vector3d::Zero());
     const Matrix12d K = element_dfdx(rest, polar_rotation(deformation_gradient(rest, x)));
     return (fd_jacobian(rest, x, 1e-6) - K).norm() / K.norm();
   };

@@ -1,7 +1,7 @@
 // Mesh loading through gmsh: the committed test mesh, and every bad input with its
 // clear error message.
-#include <catch2/catch.hpp>
 #include <Eigen/LU>
+#include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -90,7 +90,8 @@ TEST_CASE("an inverted tetrahedron is reoriented and counted", "[mesh]") {
   REQUIRE(mesh.num_tets() == 1);
   CHECK(mesh.reoriented_tets == 1);
   Eigen::Matrix3d Dm;
-  for (int i = 0; i < 3; ++i) Dm.col(i) = mesh.X.col(mesh.tets[0][i + 1]) - mesh.X.col(mesh.tets[0][0]);
+  for (int i = 0; i < 3; ++i)
+    Dm.col(i) = mesh.X.col(mesh.tets[0][i + 1]) - mesh.X.col(mesh.tets[0][0]);
   CHECK(Dm.determinant() > 0.0);
   CHECK(mesh.boundary.size() == 4);
 }
