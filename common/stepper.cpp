@@ -1,10 +1,33 @@
 #include "common/stepper.hpp"
 
 #include <iostream>
+#include <stdexcept>
+#include <string>
 
 namespace fem {
 
 long long (*allocation_count_hook)() = nullptr;
+
+Stepper::Stepper(const Scene& scene) : f_ext_(3 * scene.mesh.num_nodes()) {
+  set_external_forces(scene.external_forces);
+}
+
+void Stepper::set_external_forces(const std::vector<ExternalForce>& forces) {
+  const Eigen::Index num_nodes = f_ext_.size() / 3;
+  for (const ExternalForce& e : forces) {
+    if (e.node < 0 || e.node >= num_nodes)
+      throw std::invalid_argument("external force on node " + std::to_string(e.node) +
+                                  ", which is not in [0, " + std::to_string(num_nodes) + ")");
+    if (!e.force.allFinite())
+      throw std::invalid_argument("external force on node " + std::to_string(e.node) +
+                                  " is not finite");
+  }
+  // setZero() empties the sparse vector but keeps its capacity; coeffRef inserts in
+  // order and sums the forces that act on the same node.
+  f_ext_.setZero();
+  for (const ExternalForce& e : forces)
+    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
+}
 
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
                              const char* chapter, bool& already_warned) {

@@ -1,8 +1,10 @@
 // The interface every chapter implements, and what it measures about each step.
 #pragma once
 
+#include <Eigen/SparseCore>
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "common/allocation_hook.hpp"
 #include "common/scene.hpp"
@@ -42,6 +44,20 @@ class Stepper {
   // Advances the state by one linearized backward Euler step of scene.dt.
   virtual void step(State& state) = 0;
   virtual const StepProfile& profile() const = 0;
+
+  // Replaces the sparse interaction forces from the next step on: the scene's own, or
+  // the viewer's mouse spring. The storage is reused, so once it has held as many
+  // nonzeros this allocates nothing. Throws std::invalid_argument for a node out of
+  // range or a non-finite force.
+  void set_external_forces(const std::vector<ExternalForce>& forces);
+  const Eigen::SparseVector<double>& external_forces() const { return f_ext_; }
+
+ protected:
+  explicit Stepper(const Scene& scene);
+
+  // The poster's `sparse_vec`: a few nonzeros among 3N, kept sparse so that adding it to
+  // a dense vector touches only those entries.
+  Eigen::SparseVector<double> f_ext_;
 };
 
 // Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.

@@ -13,7 +13,7 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 
 NaiveStepper::NaiveStepper(const Scene& scene, const SolverSettings& settings)
-    : scene_(scene), model_(scene), settings_(settings) {
+    : Stepper(scene), scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());
   f_.resize(n);
@@ -33,10 +33,6 @@ NaiveStepper::NaiveStepper(const Scene& scene, const SolverSettings& settings)
   for (int k = 0; k < n; ++k) mass.emplace_back(k, k, model_.lumped_mass[k]);
   M_.resize(n, n);
   M_.setFromTriplets(mass.begin(), mass.end());
-
-  f_ext_.resize(n);
-  for (const auto& e : scene.external_forces)
-    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
 }
 
 void NaiveStepper::step(State& state) {

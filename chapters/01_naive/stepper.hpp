@@ -37,7 +37,6 @@ class NaiveStepper final : public Stepper {
 
   std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
   Eigen::VectorXd f_;                       // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;       // the sparse interaction forces
   Eigen::SparseMatrix<double> M_;           // lumped mass, a diagonal sparse matrix
   Eigen::SparseMatrix<double> dfdx_;        // pattern of the mesh connectivity, allocated once
   Eigen::SparseMatrix<double> A_;           // M - h df/dv - h^2 df/dx

@@ -13,7 +13,7 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 using Triplet = Eigen::Triplet<double>;
 
 NoAliasStepper::NoAliasStepper(const Scene& scene, const SolverSettings& settings)
-    : scene_(scene), model_(scene), settings_(settings) {
+    : Stepper(scene), scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());
   f_.resize(n);
@@ -38,10 +38,6 @@ NoAliasStepper::NoAliasStepper(const Scene& scene, const SolverSettings& setting
   identity_.resize(n, n);
   identity_.setIdentity();
   constrained_.assign(model_.num_nodes, false);
-
-  f_ext_.resize(n);
-  for (const auto& e : scene.external_forces)
-    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
 }
 
 void NoAliasStepper::step(State& state) {

@@ -17,7 +17,7 @@ using Triplet = Eigen::Triplet<double>;
 
 SystemCompositionStepper::SystemCompositionStepper(const Scene& scene,
                                                    const SolverSettings& settings)
-    : scene_(scene), model_(scene), settings_(settings) {
+    : Stepper(scene), scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());
   f_.resize(n);
@@ -48,10 +48,6 @@ SystemCompositionStepper::SystemCompositionStepper(const Scene& scene,
   identity_.resize(n, n);
   identity_.setIdentity();
   constrained_.assign(model_.num_nodes, false);
-
-  f_ext_.resize(n);
-  for (const auto& e : scene.external_forces)
-    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
 }
 
 void SystemCompositionStepper::step(State& state) {

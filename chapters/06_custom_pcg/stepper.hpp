@@ -75,7 +75,6 @@ class CustomPcgStepper final : public Stepper {
 
   std::vector<Eigen::Matrix3d> rotations_;   // R_e of the polar decomposition, per element
   Eigen::VectorXd f_;                        // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;        // the sparse interaction forces
   Eigen::SparseMatrix<double> dfdx_;         // pattern of the mesh connectivity, allocated once
   std::vector<BlockOffsets> block_offsets_;  // per element, built once with the pattern
   Eigen::SparseMatrix<double> A_;            // M - h df/dv - h^2 df/dx, the pattern of dfdx_

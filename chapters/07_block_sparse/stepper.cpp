@@ -84,7 +84,7 @@ Eigen::SparseMatrix<double> BlockSparseMatrix::to_sparse() const {
 // ---- the stepper ------------------------------------------------------------------------
 
 BlockSparseStepper::BlockSparseStepper(const Scene& scene, const SolverSettings& settings)
-    : scene_(scene), model_(scene), settings_(settings) {
+    : Stepper(scene), scene_(scene), model_(scene), settings_(settings) {
   const int n = model_.dofs;
   rotations_.resize(model_.tets.size());
   f_.resize(n);
@@ -105,10 +105,6 @@ BlockSparseStepper::BlockSparseStepper(const Scene& scene, const SolverSettings&
     for (int k = dfdx_.row_start[i]; k < dfdx_.row_start[i + 1]; ++k)
       transpose_block_[k] = dfdx_.find(dfdx_.column[k], i);
   y_.setZero(n);
-
-  f_ext_.resize(n);
-  for (const auto& e : scene.external_forces)
-    for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
 }
 
 void BlockSparseStepper::step(State& state) {

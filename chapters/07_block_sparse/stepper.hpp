@@ -83,7 +83,6 @@ class BlockSparseStepper final : public Stepper {
 
   std::vector<Eigen::Matrix3d> rotations_;           // R_e of the polar decomposition, per element
   Eigen::VectorXd f_;                                // elastic forces + gravity
-  Eigen::SparseVector<double> f_ext_;                // the sparse interaction forces
   BlockSparseMatrix dfdx_;                           // pattern of the mesh connectivity, built once
   std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b)
   BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the pattern of dfdx_
