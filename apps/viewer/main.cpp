@@ -1,0 +1,354 @@
+// fem_viewer: the simulation in a window. Pull the body with the mouse, switch chapters
+// while it moves, and watch the cost of each phase change.
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <stb/stb_image_write.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "apps/viewer/controls.hpp"
+#include "apps/viewer/panel.hpp"
+#include "apps/viewer/renderer.hpp"
+#include "chapters/registry.hpp"
+#include "common/build_info.hpp"
+#include "common/cli.hpp"
+
+namespace fv = fem::viewer;
+
+namespace {
+
+struct Options {
+  std::string chapter;
+  int frames = 0;  // 0: until the window is closed
+  int width = 1280, height = 800;
+  std::optional<fv::DragReplay> replay;
+  std::string screenshot, report;
+  bool fixed_dt = false;
+};
+
+// Keys pressed since the last frame (space, s, r), collected by a GLFW callback that the
+// ImGui backend chains to.
+struct Keys {
+  bool pause = false, step = false, reset = false;
+};
+Keys g_keys;
+std::string g_glfw_error;
+
+void on_key(GLFWwindow*, int key, int, int action, int) {
+  if (action != GLFW_PRESS || ImGui::GetCurrentContext() == nullptr ||
+      ImGui::GetIO().WantCaptureKeyboard)
+    return;
+  if (key == GLFW_KEY_SPACE) g_keys.pause = true;
+  if (key == GLFW_KEY_S) g_keys.step = true;
+  if (key == GLFW_KEY_R) g_keys.reset = true;
+}
+
+double g_wheel = 0.0;
+void on_scroll(GLFWwindow*, double, double dy) {
+  if (ImGui::GetCurrentContext() == nullptr || !ImGui::GetIO().WantCaptureMouse) g_wheel += dy;
+}
+
+std::vector<std::string> list_meshes(const std::string& current) {
+  std::vector<std::string> meshes;
+  for (const char* dir : {"meshes", "meshes/generated"}) {
+    const std::filesystem::path path = std::filesystem::path(fem::source_dir()) / dir;
+    if (!std::filesystem::is_directory(path)) continue;
+    for (const auto& entry : std::filesystem::directory_iterator(path))
+      if (entry.path().extension() == ".msh") meshes.push_back(entry.path().string());
+  }
+  std::sort(meshes.begin(), meshes.end());
+  if (std::find(meshes.begin(), meshes.end(), current) == meshes.end()) meshes.push_back(current);
+  return meshes;
+}
+
+void write_screenshot(const std::string& path, int width, int height) {
+  std::vector<unsigned char> pixels(static_cast<std::size_t>(3) * width * height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+  stbi_flip_vertically_on_write(1);  // OpenGL's rows start at the bottom
+  if (!stbi_write_png(path.c_str(), width, height, 3, pixels.data(), 3 * width))
+    throw std::runtime_error("cannot write the screenshot " + path);
+  std::cout << "fem_viewer: screenshot written to " << path << "\n";
+}
+
+std::string json_vector(const Eigen::Vector3d& v) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return out.str();
+}
+
+// The facts of a scripted run, for the smoke test and for the closing numbers.
+struct RunRecord {
+  int frames = 0;
+  double seconds = 0.0;
+  double step_seconds = 0.0;
+  long long steps = 0;
+  int grabbed_node = -1;
+  Eigen::Vector3d node_at_grab = Eigen::Vector3d::Zero(), target = Eigen::Vector3d::Zero();
+};
+
+void write_report(const std::string& path, const RunRecord& r, const fv::Session& session) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write the report " + path);
+  out.precision(17);
+  out << "{\n  \"chapter\": \"" << session.chapter() << "\",\n  \"mesh\": \""
+      << session.scene().mesh.file << "\",\n  \"nodes\": " << session.scene().mesh.num_nodes()
+      << ",\n  \"frames\": " << r.frames << ",\n  \"seconds\": " << r.seconds
+      << ",\n  \"frames_per_second\": " << r.frames / std::max(r.seconds, 1e-9)
+      << ",\n  \"steps\": " << r.steps
+      << ",\n  \"mean_step_ms\": " << 1e3 * r.step_seconds / std::max<long long>(r.steps, 1)
+      << ",\n  \"grabbed_node\": " << r.grabbed_node
+      << ",\n  \"node_at_grab\": " << json_vector(r.node_at_grab)
+      << ",\n  \"target\": " << json_vector(r.target) << ",\n  \"node_at_end\": "
+      << json_vector(r.grabbed_node >= 0 ? Eigen::Vector3d(session.state().x.segment<3>(3 * r.grabbed_node))
+                                          : Eigen::Vector3d::Zero())
+      << "\n}\n";
+  std::cout << "fem_viewer: report written to " << path << "\n";
+}
+
+// Steps the session as the clock mode says; returns the seconds spent stepping.
+double advance(fv::Session& session, fv::PanelState& panel, double frame_seconds) {
+  const auto start = std::chrono::steady_clock::now();
+  int steps = panel.paused ? 0 : 1;
+  if (!panel.paused && panel.mode == fv::StepMode::FixedDt) {
+    // As many steps as the wall clock asks for, at most 8 a frame: beyond that the
+    // simulation falls behind and the panel says so.
+    const int wanted = static_cast<int>(frame_seconds / session.scene().dt + 0.5);
+    steps = std::min(wanted, 8);
+    panel.behind_steps = std::max(wanted - steps, 0);
+  }
+  if (panel.step_once) steps = std::max(steps, 1);
+  panel.step_once = false;
+  for (int k = 0; k < steps; ++k)
+    if (!session.step()) break;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Applies what the user asked for in the panel or with the keys.
+void handle_requests(std::unique_ptr<fv::Session>& session, fv::PanelState& panel,
+                     fv::Renderer& renderer, fv::OrbitCamera& camera) {
+  if (g_keys.pause) panel.paused = !panel.paused;
+  if (g_keys.step) panel.step_once = true;
+  if (g_keys.reset) panel.reset = true;
+  g_keys = {};
+  try {
+    if (panel.chapter) session->set_chapter(*panel.chapter);
+    if (panel.reset) session->reset();
+    if (panel.apply) {
+      const std::string old_scene = session->settings().scene;
+      session->apply(panel.edited);
+      if (session->settings().scene != old_scene) renderer.set_scene(session->scene());
+      panel.error.clear();
+    }
+    if (panel.mesh) {
+      fem::TetMesh mesh = fem::load_mesh(*panel.mesh);
+      session = std::make_unique<fv::Session>(std::move(mesh), panel.edited, session->chapter());
+      renderer.set_scene(session->scene());
+      const fem::TetMesh& m = session->scene().mesh;
+      camera.frame(Eigen::AlignedBox3d(m.X.rowwise().minCoeff(), m.X.rowwise().maxCoeff()));
+      panel.error.clear();
+    }
+  } catch (const std::exception& e) {
+    panel.error = e.what();
+  }
+  panel.chapter.reset();
+  panel.mesh.reset();
+  panel.reset = panel.apply = false;
+}
+
+GLFWwindow* open_window(const Options& options) {
+  glfwSetErrorCallback([](int, const char* text) { g_glfw_error = text; });
+  if (!glfwInit())
+    throw std::runtime_error(
+        "cannot open a window: " + g_glfw_error +
+        ". The viewer needs a display: run it on a desktop, or headless under Xvfb: "
+        "xvfb-run -a build/release/fem_viewer");
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_SAMPLES, 4);
+  GLFWwindow* window = glfwCreateWindow(options.width, options.height,
+                                        "Eigen FEM tutorial: fem_viewer", nullptr, nullptr);
+  if (window == nullptr) {
+    glfwTerminate();
+    throw std::runtime_error("cannot create an OpenGL 3.3 core window: " + g_glfw_error);
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(options.frames > 0 ? 0 : 1);  // scripted runs measure, not wait for vsync
+  glfwSetKeyCallback(window, on_key);
+  glfwSetScrollCallback(window, on_scroll);
+  return window;
+}
+
+// The window, its OpenGL context and Dear ImGui, released in reverse order on every path.
+struct Window {
+  explicit Window(const Options& options) : handle(open_window(options)) {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the working directory
+    ImGui_ImplGlfw_InitForOpenGL(handle, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+  }
+  ~Window() {
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(handle);
+    glfwTerminate();
+  }
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+  GLFWwindow* handle;
+};
+
+fv::MouseInput mouse_from(GLFWwindow* window) {
+  fv::MouseInput mouse;
+  glfwGetCursorPos(window, &mouse.x, &mouse.y);
+  mouse.left = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  mouse.right = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+  mouse.middle = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;
+  mouse.wheel = g_wheel;
+  g_wheel = 0.0;
+  return mouse;
+}
+
+void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Options& options) {
+  fv::Renderer renderer;
+  renderer.set_scene(session->scene());
+  fv::OrbitCamera camera;
+  const fem::TetMesh& mesh = session->scene().mesh;
+  camera.frame(Eigen::AlignedBox3d(mesh.X.rowwise().minCoeff(), mesh.X.rowwise().maxCoeff()));
+  fv::MouseControls controls;
+  fv::PanelState panel;
+  panel.edited = session->settings();
+  panel.mode = options.fixed_dt ? fv::StepMode::FixedDt : fv::StepMode::OneStepPerFrame;
+  panel.meshes = list_meshes(mesh.file);
+  panel.mesh_index = static_cast<int>(
+      std::find(panel.meshes.begin(), panel.meshes.end(), mesh.file) - panel.meshes.begin());
+
+  std::optional<fv::DragReplay> replay = options.replay;  // it remembers where it started
+  RunRecord record;
+  const auto start = std::chrono::steady_clock::now();
+  auto last_frame = start;
+  for (int frame = 0; !glfwWindowShouldClose(window); ++frame) {
+    if (options.frames > 0 && frame >= options.frames) break;
+    glfwPollEvents();
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window, &width, &height);
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+
+    const fv::MouseInput mouse =
+        replay ? replay->input(frame, width, height, camera, *session) : mouse_from(window);
+    const bool had_grab = session->grabbed().has_value();
+    controls.update(mouse, !replay && ImGui::GetIO().WantCaptureMouse, width, height,
+                    camera, *session);
+    if (!had_grab && session->grabbed()) {
+      record.grabbed_node = session->grabbed()->node;
+      record.node_at_grab = session->state().x.segment<3>(3 * record.grabbed_node);
+    }
+    if (session->grabbed()) record.target = session->grabbed()->target;
+
+    const auto now = std::chrono::steady_clock::now();
+    const double frame_seconds = std::chrono::duration<double>(now - last_frame).count();
+    last_frame = now;
+    const long long steps_before = session->steps();
+    record.step_seconds += advance(*session, panel, frame_seconds);
+    record.steps += session->steps() - steps_before;
+
+    draw_panel(*session, ImGui::GetIO().Framerate, panel);
+    ImGui::Render();
+    renderer.draw(session->state(), session->grabbed(), camera, width, height);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    handle_requests(session, panel, renderer, camera);
+    if (!options.screenshot.empty() && options.frames > 0 && frame == options.frames - 1)
+      write_screenshot(options.screenshot, width, height);
+    glfwSwapBuffers(window);
+    record.frames = frame + 1;
+  }
+  record.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("
+            << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
+            << session->chapter() << ", mean step "
+            << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1) << " ms\n";
+  if (!options.report.empty()) write_report(options.report, record, *session);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace fem;
+  ArgParser args("fem_viewer",
+                 "Real-time viewer: drag the body with the mouse, switch chapters live.");
+  add_scene_options(args, "meshes/plate_poster.msh");
+  add_solver_options(args);
+  args.option("chapter", "NAME", "stepper to start with (switch in the panel)", chapters().back().id);
+  args.option("frames", "N", "stop after N frames (0: run until the window is closed)", "0");
+  args.option("width", "PIXELS", "window width", "1280");
+  args.option("height", "PIXELS", "window height", "800");
+  args.option("replay-drag", "SPEC",
+              "scripted mouse drag: 'auto' (pull the far end up) or x0,y0,x1,y1 in window "
+              "fractions; needs --frames",
+              "");
+  args.option("screenshot", "FILE", "write a PNG of the last frame (needs --frames)", "");
+  args.option("report", "FILE", "write the run's facts as JSON (frame rate, dragged node)", "");
+  args.flag("fixed-dt", "start in fixed-dt mode (simulated time follows the wall clock)");
+  try {
+    if (!args.parse(argc, argv)) return 0;
+    Options options;
+    try {
+      options.chapter = find_chapter(args.get("chapter")).id;
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    options.frames = args.get_int("frames");
+    options.width = args.get_int("width");
+    options.height = args.get_int("height");
+    options.screenshot = args.get("screenshot");
+    options.report = args.get("report");
+    options.fixed_dt = args.has_flag("fixed-dt");
+    if (options.frames < 0) throw UsageError("--frames must be >= 0");
+    if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
+      throw UsageError("--width and --height must be in [64, 8192]");
+    const bool scripted = !args.get("replay-drag").empty() || !options.screenshot.empty();
+    if (scripted && options.frames == 0)
+      throw UsageError("--replay-drag and --screenshot need --frames N");
+    if (!args.get("replay-drag").empty()) {
+      try {
+        options.replay = fv::DragReplay::parse(args.get("replay-drag"), options.frames);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
+    const Scene scene = scene_from_args(args);
+    fv::SessionSettings settings;
+    settings.scene = scene.name;
+    settings.material = scene.material;
+    settings.damping = scene.damping;
+    settings.dt = scene.dt;
+    settings.solver = solver_from_args(args);
+    auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
+    std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
+              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << "\n";
+
+    const Window window(options);
+    run(window.handle, session, options);
+  } catch (const UsageError& e) {
+    std::cerr << "fem_viewer: " << e.what() << " (see fem_viewer --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "fem_viewer: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

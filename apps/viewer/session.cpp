@@ -1,0 +1,147 @@
+#include "apps/viewer/session.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "chapters/registry.hpp"
+#include "common/model.hpp"
+
+namespace fem::viewer {
+
+namespace {
+
+constexpr std::size_t kHistory = 60;  // steps kept for the panel's averages and plot
+
+Scene build_scene(const SessionSettings& settings, TetMesh mesh) {
+  Scene scene = make_scene(settings.scene, std::move(mesh), settings.material);
+  scene.dt = settings.dt;
+  scene.damping = settings.damping;
+  validate(scene);
+  return scene;
+}
+
+}  // namespace
+
+double spring_stiffness(double body_weight_per_diagonal, double relative_stiffness,
+                        double patch_mass, double dt) {
+  const double wanted = relative_stiffness * body_weight_per_diagonal;
+  const double stable = patch_mass / (dt * dt);
+  return std::min(wanted, stable);
+}
+
+Session::Session(TetMesh mesh, const SessionSettings& settings, const std::string& chapter)
+    : settings_(settings),
+      scene_(build_scene(settings, std::move(mesh))),
+      chapter_(find_chapter(chapter).id) {
+  rebuild_stepper();
+  state_ = rest_state(scene_);
+}
+
+void Session::rebuild_stepper() {
+  const Model model(scene_);
+  node_mass_.resize(model.num_nodes);
+  for (int i = 0; i < model.num_nodes; ++i) node_mass_[i] = model.lumped_mass[3 * i];
+  const Eigen::Vector3d lo = scene_.mesh.X.rowwise().minCoeff();
+  const Eigen::Vector3d hi = scene_.mesh.X.rowwise().maxCoeff();
+  diagonal_ = (hi - lo).norm();
+  weight_per_diagonal_ = node_mass_.sum() * scene_.gravity.norm() / diagonal_;
+  stepper_ = make_stepper(chapter_, scene_, settings_.solver);
+  history_.clear();
+}
+
+void Session::set_chapter(const std::string& chapter) {
+  chapter_ = find_chapter(chapter).id;
+  stepper_ = make_stepper(chapter_, scene_, settings_.solver);
+  history_.clear();
+}
+
+void Session::apply(const SessionSettings& settings) {
+  const bool restart = settings.scene != settings_.scene;
+  Scene scene = build_scene(settings, scene_.mesh);  // throws before anything changes
+  settings_ = settings;
+  scene_ = std::move(scene);
+  rebuild_stepper();
+  if (restart) reset();
+}
+
+void Session::reset() {
+  state_ = rest_state(scene_);
+  time_ = 0.0;
+  steps_ = 0;
+  grab_.reset();
+  history_.clear();
+  stepper_ = make_stepper(chapter_, scene_, settings_.solver);  // forgets the warm start
+}
+
+bool Session::step() {
+  // The scene's own interaction forces, plus the spring: both are the sparse f_ext.
+  forces_ = scene_.external_forces;
+  const std::vector<ExternalForce> spring = spring_forces();
+  forces_.insert(forces_.end(), spring.begin(), spring.end());
+  stepper_->set_external_forces(forces_);
+  stepper_->step(state_);
+  if (!state_.x.allFinite() || !state_.v.allFinite()) {
+    message_ = "the simulation diverged at t = " + std::to_string(time_) +
+               " s and was reset: try a smaller dt, a softer spring or more damping";
+    reset();
+    return false;
+  }
+  time_ += scene_.dt;
+  ++steps_;
+  history_.push_back(stepper_->profile());
+  if (history_.size() > kHistory) history_.pop_front();
+  return true;
+}
+
+void Session::grab(int node, const Eigen::Vector3d& target) {
+  if (node < 0 || node >= scene_.mesh.num_nodes())
+    throw std::invalid_argument("grab: node " + std::to_string(node) + " is not in the mesh");
+  grab_ = Grab{node, target};
+  patch_.clear();
+  patch_mass_ = 0.0;
+  const Eigen::Vector3d centre = scene_.mesh.X.col(node);
+  for (int j = 0; j < scene_.mesh.num_nodes(); ++j) {
+    if ((scene_.mesh.X.col(j) - centre).norm() > kGrabRadius * diagonal_) continue;
+    patch_.push_back(j);  // the grabbed node itself is always in
+    patch_mass_ += node_mass_[j];
+  }
+}
+
+void Session::move_grab(const Eigen::Vector3d& target) {
+  if (grab_) grab_->target = target;
+}
+
+void Session::release() { grab_.reset(); }
+
+std::vector<ExternalForce> Session::spring_forces() const {
+  if (!grab_) return {};
+  const double k = spring_stiffness(weight_per_diagonal_, settings_.spring, patch_mass_, scene_.dt);
+  const Eigen::Vector3d pull =
+      k * (grab_->target - state_.x.segment<3>(3 * static_cast<Eigen::Index>(grab_->node)));
+  std::vector<ExternalForce> forces;
+  forces.reserve(patch_.size());
+  for (const int j : patch_) forces.push_back({j, pull * (node_mass_[j] / patch_mass_)});
+  return forces;
+}
+
+StepProfile Session::mean_profile() const {
+  StepProfile mean;
+  if (history_.empty()) return mean;
+  const double n = static_cast<double>(history_.size());
+  double iterations = 0.0;
+  for (const StepProfile& p : history_) {
+    mean.forces.seconds += p.forces.seconds / n;
+    mean.dfdx.seconds += p.dfdx.seconds / n;
+    mean.compose.seconds += p.compose.seconds / n;
+    mean.constraints.seconds += p.constraints.seconds / n;
+    mean.solve.seconds += p.solve.seconds / n;
+    mean.step.seconds += p.step.seconds / n;
+    iterations += p.cg_iterations / n;
+    mean.converged = mean.converged && p.converged;
+  }
+  mean.cg_iterations = static_cast<int>(iterations + 0.5);
+  mean.relative_residual = history_.back().relative_residual;
+  return mean;
+}
+
+}  // namespace fem::viewer
