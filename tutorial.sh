@@ -15,6 +15,9 @@ APT_PACKAGES=(
   libeigen3-dev catch2
   # gmsh's runtime libraries (the PyPI wheel links against them)
   libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
+  # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
+  # screenshots; Xvfb and Mesa's software renderer run it headless in the tests
+  pkg-config libglfw3-dev libgl-dev libimgui-dev libstb-dev xvfb xauth libgl1-mesa-dri
 )
 
 usage() {
@@ -35,6 +38,8 @@ commands:
              tables (fem_lessons) and the chapter diffs (docs/diffs/); run bench (and scaling) first
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
+  viewer     build and open the interactive viewer (fem_viewer --help for its options): drag the
+             body with the mouse, switch chapters live; needs a display
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
   help       this text (also --help, -h)
 
@@ -149,6 +154,13 @@ sim() {
   "$VENV/bin/python" scripts/render_gif.py "$pvd" --out docs/images/cantilever.gif
 }
 
+viewer() {
+  build
+  [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
+  log "opening the viewer (space: pause, s: step, r: reset; drag the body with the mouse)"
+  "$BUILD_DIR/fem_viewer" "$@"
+}
+
 meshes() {
   setup_venv
   "$VENV/bin/python" meshes/generate.py "$@"
@@ -165,6 +177,7 @@ main() {
     scaling) scaling "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;
+    viewer) viewer "$@" ;;
     meshes) meshes "$@" ;;
     help | --help | -h) usage ;;
     *)

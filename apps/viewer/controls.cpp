@@ -73,10 +73,12 @@ DragReplay DragReplay::parse(const std::string& spec, int total_frames) {
     }
   }
   if (values.size() != 4)
-    throw std::invalid_argument("--replay-drag takes 'auto' or x0,y0,x1,y1 (fractions of the window)");
+    throw std::invalid_argument(
+        "--replay-drag takes 'auto' or x0,y0,x1,y1 (fractions of the window)");
   for (const double v : values)
     if (!(v >= 0.0 && v <= 1.0))
-      throw std::invalid_argument("--replay-drag: coordinates are fractions of the window, in [0, 1]");
+      throw std::invalid_argument(
+          "--replay-drag: coordinates are fractions of the window, in [0, 1]");
   replay.automatic_ = false;
   replay.from_ = {values[0], values[1]};
   replay.to_ = {values[2], values[3]};

@@ -22,8 +22,8 @@ struct MouseInput {
 // middle: pan. Wheel: zoom.
 class MouseControls {
  public:
-  void update(const MouseInput& mouse, bool over_panel, int width, int height,
-              OrbitCamera& camera, Session& session);
+  void update(const MouseInput& mouse, bool over_panel, int width, int height, OrbitCamera& camera,
+              Session& session);
 
  private:
   enum class Mode { None, Orbit, Pan, Drag };

@@ -29,6 +29,7 @@ struct Options {
   std::optional<fv::DragReplay> replay;
   std::string screenshot, report;
   bool fixed_dt = false;
+  bool paused = false;
 };
 
 // Keys pressed since the last frame (space, s, r), collected by a GLFW callback that the
@@ -107,8 +108,9 @@ void write_report(const std::string& path, const RunRecord& r, const fv::Session
       << ",\n  \"grabbed_node\": " << r.grabbed_node
       << ",\n  \"node_at_grab\": " << json_vector(r.node_at_grab)
       << ",\n  \"target\": " << json_vector(r.target) << ",\n  \"node_at_end\": "
-      << json_vector(r.grabbed_node >= 0 ? Eigen::Vector3d(session.state().x.segment<3>(3 * r.grabbed_node))
-                                          : Eigen::Vector3d::Zero())
+      << json_vector(r.grabbed_node >= 0
+                         ? Eigen::Vector3d(session.state().x.segment<3>(3 * r.grabbed_node))
+                         : Eigen::Vector3d::Zero())
       << "\n}\n";
   std::cout << "fem_viewer: report written to " << path << "\n";
 }
@@ -229,6 +231,7 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
   fv::MouseControls controls;
   fv::PanelState panel;
   panel.edited = session->settings();
+  panel.paused = options.paused;
   panel.mode = options.fixed_dt ? fv::StepMode::FixedDt : fv::StepMode::OneStepPerFrame;
   panel.meshes = list_meshes(mesh.file);
   panel.mesh_index = static_cast<int>(
@@ -250,8 +253,8 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
     const fv::MouseInput mouse =
         replay ? replay->input(frame, width, height, camera, *session) : mouse_from(window);
     const bool had_grab = session->grabbed().has_value();
-    controls.update(mouse, !replay && ImGui::GetIO().WantCaptureMouse, width, height,
-                    camera, *session);
+    controls.update(mouse, !replay && ImGui::GetIO().WantCaptureMouse, width, height, camera,
+                    *session);
     if (!had_grab && session->grabbed()) {
       record.grabbed_node = session->grabbed()->node;
       record.node_at_grab = session->state().x.segment<3>(3 * record.grabbed_node);
@@ -275,8 +278,7 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
     glfwSwapBuffers(window);
     record.frames = frame + 1;
   }
-  record.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("
             << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
             << session->chapter() << ", mean step "
@@ -292,7 +294,8 @@ int main(int argc, char** argv) {
                  "Real-time viewer: drag the body with the mouse, switch chapters live.");
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
-  args.option("chapter", "NAME", "stepper to start with (switch in the panel)", chapters().back().id);
+  args.option("chapter", "NAME", "stepper to start with (switch in the panel)",
+              chapters().back().id);
   args.option("frames", "N", "stop after N frames (0: run until the window is closed)", "0");
   args.option("width", "PIXELS", "window width", "1280");
   args.option("height", "PIXELS", "window height", "800");
@@ -303,6 +306,7 @@ int main(int argc, char** argv) {
   args.option("screenshot", "FILE", "write a PNG of the last frame (needs --frames)", "");
   args.option("report", "FILE", "write the run's facts as JSON (frame rate, dragged node)", "");
   args.flag("fixed-dt", "start in fixed-dt mode (simulated time follows the wall clock)");
+  args.flag("paused", "start paused (space resumes): --frames then measures drawing alone");
   try {
     if (!args.parse(argc, argv)) return 0;
     Options options;
@@ -317,6 +321,7 @@ int main(int argc, char** argv) {
     options.screenshot = args.get("screenshot");
     options.report = args.get("report");
     options.fixed_dt = args.has_flag("fixed-dt");
+    options.paused = args.has_flag("paused");
     if (options.frames < 0) throw UsageError("--frames must be >= 0");
     if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
       throw UsageError("--width and --height must be in [64, 8192]");

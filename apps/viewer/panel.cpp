@@ -34,7 +34,8 @@ void phase_bars(const Session& session) {
   for (const auto& [name, seconds] : phases) {
     char label[32];
     std::snprintf(label, sizeof label, "%.3f ms", 1e3 * seconds);
-    const float fraction = mean.step.seconds > 0 ? static_cast<float>(seconds / mean.step.seconds) : 0;
+    const float fraction =
+        mean.step.seconds > 0 ? static_cast<float>(seconds / mean.step.seconds) : 0;
     ImGui::ProgressBar(fraction, ImVec2(180, 0), label);
     ImGui::SameLine();
     ImGui::TextUnformatted(name);
@@ -95,11 +96,13 @@ void scene_controls(const Session& session, PanelState& state) {
   slider("beta [s]", s.damping.beta, 0.0, 0.1, false);
   slider("dt [s]", s.dt, 1e-4, 0.05, true);
   slider("spring", s.spring, 0.1, 100.0, true);
-  if (ImGui::IsItemHovered()) ImGui::SetTooltip("stiffness of the mouse spring, in body weights per bounding-box diagonal");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("stiffness of the mouse spring, in body weights per bounding-box diagonal");
   if (ImGui::Button("apply")) state.apply = true;
   ImGui::SameLine();
   ImGui::TextDisabled("(a new scene restarts from rest)");
-  ImGui::Text("%s: %d nodes, %d tets", std::filesystem::path(session.scene().mesh.file).filename().c_str(),
+  ImGui::Text("%s: %d nodes, %d tets",
+              std::filesystem::path(session.scene().mesh.file).filename().c_str(),
               session.scene().mesh.num_nodes(), session.scene().mesh.num_tets());
 }
 

@@ -11,9 +11,9 @@
 namespace fem::viewer {
 
 struct SurfaceHit {
-  int node = -1;           // the hit triangle's corner nearest to the hit point
-  double distance = 0.0;   // along the ray
-  Eigen::Vector3d point;   // where the ray meets the surface
+  int node = -1;          // the hit triangle's corner nearest to the hit point
+  double distance = 0.0;  // along the ray
+  Eigen::Vector3d point;  // where the ray meets the surface
 };
 
 // The nearest hit in front of the ray's origin, if any. x stacks the node positions.

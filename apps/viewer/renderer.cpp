@@ -122,8 +122,8 @@ void make_vertex_array(unsigned& vao, unsigned& vbo) {
 
 void upload(unsigned vbo, const std::vector<float>& data) {
   glBindBuffer(GL_ARRAY_BUFFER, vbo);
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)),
-               data.data(), GL_STREAM_DRAW);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(),
+               GL_STREAM_DRAW);
 }
 
 void push(std::vector<float>& out, const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
@@ -239,8 +239,8 @@ void Renderer::upload_points(const State& state, const std::optional<Grab>& grab
   draw_spring_ = grab.has_value();
 }
 
-void Renderer::draw(const State& state, const std::optional<Grab>& grab,
-                    const OrbitCamera& camera, int width, int height) {
+void Renderer::draw(const State& state, const std::optional<Grab>& grab, const OrbitCamera& camera,
+                    int width, int height) {
   glViewport(0, 0, width, height);
   glClearColor(0.16f, 0.18f, 0.22f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);

@@ -96,6 +96,7 @@ bool Session::step() {
 void Session::grab(int node, const Eigen::Vector3d& target) {
   if (node < 0 || node >= scene_.mesh.num_nodes())
     throw std::invalid_argument("grab: node " + std::to_string(node) + " is not in the mesh");
+  if (!target.allFinite()) throw std::invalid_argument("grab: the target is not finite");
   grab_ = Grab{node, target};
   patch_.clear();
   patch_mass_ = 0.0;
@@ -108,7 +109,7 @@ void Session::grab(int node, const Eigen::Vector3d& target) {
 }
 
 void Session::move_grab(const Eigen::Vector3d& target) {
-  if (grab_) grab_->target = target;
+  if (grab_ && target.allFinite()) grab_->target = target;
 }
 
 void Session::release() { grab_.reset(); }
@@ -116,8 +117,11 @@ void Session::release() { grab_.reset(); }
 std::vector<ExternalForce> Session::spring_forces() const {
   if (!grab_) return {};
   const double k = spring_stiffness(weight_per_diagonal_, settings_.spring, patch_mass_, scene_.dt);
-  const Eigen::Vector3d pull =
-      k * (grab_->target - state_.x.segment<3>(3 * static_cast<Eigen::Index>(grab_->node)));
+  const Eigen::Vector3d stretch =
+      grab_->target - state_.x.segment<3>(3 * static_cast<Eigen::Index>(grab_->node));
+  const double length = stretch.stableNorm();  // norm() would square 1e300 into infinity
+  const double longest = kMaxPull * diagonal_;
+  const Eigen::Vector3d pull = k * (length > longest ? (longest / length) * stretch : stretch);
   std::vector<ExternalForce> forces;
   forces.reserve(patch_.size());
   for (const int j : patch_) forces.push_back({j, pull * (node_mass_[j] / patch_mass_)});

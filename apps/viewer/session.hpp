@@ -43,6 +43,9 @@ struct Grab {
 double spring_stiffness(double body_weight_per_diagonal, double relative_stiffness,
                         double patch_mass, double dt);
 constexpr double kGrabRadius = 0.05;
+// The spring's length is capped at this many bounding-box diagonals: a mouse ray that
+// grazes the drag plane puts the target very far away, and must not fling the body.
+constexpr double kMaxPull = 2.0;
 
 class Session {
  public:
@@ -58,8 +61,9 @@ class Session {
   // the step produced non-finite values (the message says what to change).
   bool step();
 
+  // Throws std::invalid_argument for a node not in the mesh or a non-finite target.
   void grab(int node, const Eigen::Vector3d& target);
-  void move_grab(const Eigen::Vector3d& target);
+  void move_grab(const Eigen::Vector3d& target);  // a non-finite target is ignored
   void release();
   const std::optional<Grab>& grabbed() const { return grab_; }
 

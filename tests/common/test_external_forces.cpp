@@ -65,9 +65,8 @@ TEST_CASE("bad external forces are refused with the reason", "[external]") {
                     Catch::Contains("not in [0, " + std::to_string(n) + ")"));
   CHECK_THROWS_WITH(stepper->set_external_forces({{-1, Eigen::Vector3d::UnitZ()}}),
                     Catch::Contains("node -1"));
-  CHECK_THROWS_WITH(
-      stepper->set_external_forces({{0, Eigen::Vector3d(std::nan(""), 0.0, 0.0)}}),
-      Catch::Contains("not finite"));
+  CHECK_THROWS_WITH(stepper->set_external_forces({{0, Eigen::Vector3d(std::nan(""), 0.0, 0.0)}}),
+                    Catch::Contains("not finite"));
 }
 
 TEST_CASE("moving the spring from node to node allocates nothing once the storage is sized",
@@ -76,8 +75,7 @@ TEST_CASE("moving the spring from node to node allocates nothing once the storag
   const Scene scene = test::test_scene("cantilever");
   auto stepper = make_stepper("07", scene);
   stepper->set_external_forces({{0, Eigen::Vector3d::UnitZ()}, {1, Eigen::Vector3d::UnitY()}});
-  std::vector<ExternalForce> moved = {{5, Eigen::Vector3d::UnitX()},
-                                      {7, Eigen::Vector3d::UnitZ()}};
+  std::vector<ExternalForce> moved = {{5, Eigen::Vector3d::UnitX()}, {7, Eigen::Vector3d::UnitZ()}};
   alloc::Scope scope;
   stepper->set_external_forces(moved);
   CHECK(scope.allocations() == 0);
