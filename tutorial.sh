@@ -35,7 +35,8 @@ commands:
              results/scaling.png
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
              the README and the chapter READMEs, plots copied to docs/images/), the lesson
-             tables (fem_lessons) and the chapter diffs (docs/diffs/); run bench (and scaling) first
+             tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
+             (docs/images/viewer.png, headless); run bench (and scaling) first
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   viewer     build and open the interactive viewer (fem_viewer --help for its options): drag the
@@ -142,6 +143,11 @@ docs() {
   "$VENV/bin/python" scripts/update_docs.py --images docs/images
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py
+  if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then
+    log "viewer screenshot (headless, Xvfb): docs/images/viewer.png"
+    xvfb-run -a -s "-screen 0 1280x800x24" "$BUILD_DIR/fem_viewer" --frames 90 \
+      --replay-drag auto --screenshot docs/images/viewer.png >/dev/null
+  fi
 }
 
 sim() {
