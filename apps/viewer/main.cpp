@@ -133,6 +133,17 @@ double advance(fv::Session& session, fv::PanelState& panel, double frame_seconds
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Frames the mesh in the part of the window right of the panel: farther away by the
+// ratio of the widths, and moved right by half the panel's width.
+void frame_beside_panel(fv::OrbitCamera& camera, const fem::TetMesh& mesh) {
+  camera.frame(Eigen::AlignedBox3d(mesh.X.rowwise().minCoeff(), mesh.X.rowwise().maxCoeff()));
+  int width = 0, height = 0;
+  glfwGetFramebufferSize(glfwGetCurrentContext(), &width, &height);
+  if (width < 2 * fv::kPanelWidth) return;
+  camera.distance *= width / (width - fv::kPanelWidth);
+  camera.pan(0.5 * fv::kPanelWidth, 0.0, height);
+}
+
 // Applies what the user asked for in the panel or with the keys.
 void handle_requests(std::unique_ptr<fv::Session>& session, fv::PanelState& panel,
                      fv::Renderer& renderer, fv::OrbitCamera& camera) {
@@ -153,8 +164,7 @@ void handle_requests(std::unique_ptr<fv::Session>& session, fv::PanelState& pane
       fem::TetMesh mesh = fem::load_mesh(*panel.mesh);
       session = std::make_unique<fv::Session>(std::move(mesh), panel.edited, session->chapter());
       renderer.set_scene(session->scene());
-      const fem::TetMesh& m = session->scene().mesh;
-      camera.frame(Eigen::AlignedBox3d(m.X.rowwise().minCoeff(), m.X.rowwise().maxCoeff()));
+      frame_beside_panel(camera, session->scene().mesh);
       panel.error.clear();
     }
   } catch (const std::exception& e) {
@@ -227,7 +237,7 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
   renderer.set_scene(session->scene());
   fv::OrbitCamera camera;
   const fem::TetMesh& mesh = session->scene().mesh;
-  camera.frame(Eigen::AlignedBox3d(mesh.X.rowwise().minCoeff(), mesh.X.rowwise().maxCoeff()));
+  frame_beside_panel(camera, mesh);
   fv::MouseControls controls;
   fv::PanelState panel;
   panel.edited = session->settings();

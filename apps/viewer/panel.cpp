@@ -110,7 +110,7 @@ void scene_controls(const Session& session, PanelState& state) {
 
 void draw_panel(const Session& session, double frames_per_second, PanelState& state) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Eigen FEM tutorial");
   ImGui::Text("%.1f frames/s   t = %.2f s   %lld steps", frames_per_second, session.time(),
               session.steps());

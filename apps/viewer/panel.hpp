@@ -31,6 +31,8 @@ struct PanelState {
   int behind_steps = 0;             // FixedDt: steps that did not fit in the last frame
 };
 
+constexpr float kPanelWidth = 340.0f;  // [pixels]
+
 // Draws the panel for this frame and records the user's requests in `state`.
 void draw_panel(const Session& session, double frames_per_second, PanelState& state);
 

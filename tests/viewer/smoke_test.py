@@ -41,7 +41,13 @@ def scripted_drag(viewer, mesh, out):
                "--width", str(WIDTH), "--height", str(HEIGHT),
                "--screenshot", str(screenshot), "--report", str(report)]
     print(" ".join(command))
-    run = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    # Under the asan preset: Mesa's software driver is loaded with dlopen and unloaded at
+    # exit, and LeakSanitizer then reports its few hundred bytes from an "<unknown module>"
+    # that no suppression can name. The viewer's own code is leak-checked by
+    # test_viewer_core; here leaks are not checked (the other ASan checks stay on).
+    env = dict(os.environ)
+    env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":detect_leaks=0"
+    run = subprocess.run(command, capture_output=True, text=True, timeout=300, env=env)
     print(run.stdout + run.stderr)
     check(run.returncode == 0, f"the scripted run exits with status 0 (got {run.returncode})")
 
