@@ -36,9 +36,13 @@ commands:
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
              the README and the chapter READMEs, plots copied to docs/images/), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
-             (docs/images/viewer.png, headless); run bench (and scaling) first
+             (docs/images/viewer.png, headless); run bench first (scaling and viewer-bench
+             too, for their tables: without their results the committed tables stay)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
+  viewer-bench
+             build and measure the viewer's frame rate per chapter on the poster-sized mesh,
+             headless (Xvfb): results/viewer.json, shown in the README by docs
   viewer     build and open the interactive viewer (fem_viewer --help for its options): drag the
              body with the mouse, switch chapters live; needs a display
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
@@ -167,6 +171,13 @@ viewer() {
   "$BUILD_DIR/fem_viewer" "$@"
 }
 
+viewer_bench() {
+  build
+  [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
+  log "the viewer's frame rate per chapter, headless (Xvfb, Mesa's software OpenGL)"
+  "$VENV/bin/python" scripts/viewer_fps.py --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"
+}
+
 meshes() {
   setup_venv
   "$VENV/bin/python" meshes/generate.py "$@"
@@ -184,6 +195,7 @@ main() {
     docs) docs ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;
+    viewer-bench) viewer_bench "$@" ;;
     meshes) meshes "$@" ;;
     help | --help | -h) usage ;;
     *)

@@ -20,6 +20,7 @@
 #include "common/alloc_counter.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
+#include "common/json.hpp"
 
 namespace {
 
@@ -243,15 +244,6 @@ std::string git_commit() {
   }
   while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
   return out.empty() ? "unknown" : out;
-}
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
 }
 
 std::string spread_json(const std::array<Spread, 6>& ms, double Spread::*field) {

@@ -109,9 +109,23 @@ def validate_scaling(data):
     return problems
 
 
-def load_checked(path, scaling=False):
+def validate_viewer(data):
+    """Problems of a results/viewer.json (scripts/viewer_fps.py): one fem_viewer report per run."""
+    if not isinstance(data, dict) or not isinstance(data.get("runs"), list) or not data["runs"]:
+        return ["viewer: expected an object with a non-empty 'runs' list"]
+    problems = []
+    for i, run in enumerate(data["runs"]):
+        for key in ("run", "chapter", "nodes", "frames", "frames_per_second", "mean_step_ms",
+                    "width", "height", "renderer", "cpu", "compiler", "flags"):
+            if not isinstance(run, dict) or key not in run:
+                problems.append(f"runs[{i}]: missing '{key}'")
+    return problems
+
+
+def load_checked(path, scaling=False, viewer=False):
     data = load(path)
-    problems = validate_scaling(data) if scaling else validate_bench(data)
+    problems = (validate_scaling(data) if scaling else validate_viewer(data) if viewer
+                else validate_bench(data))
     if problems:
         raise ResultsError(f"{path}: does not match the schema:\n  " + "\n  ".join(problems))
     return data

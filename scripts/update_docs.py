@@ -4,7 +4,7 @@ comments (never typed by hand):
 
   docs/results.md          results:machine, results:phases, results:speedups,
                            results:allocations, results:solvers, results:scaling
-  README.md                headline
+  README.md                headline, chapter-map, viewer-fps (from results/viewer.json)
   chapters/NN_*/README.md  bench-table:<chapter>, and results:solvers where present
 
     .venv/bin/python scripts/update_docs.py                  # from results/bench.json
@@ -114,6 +114,21 @@ def scaling_table(scaling):
     return table(["median step ms / nodes"] + [str(n) for n in sizes], rows)
 
 
+def viewer_table(viewer):
+    """The viewer's frame rate per chapter (results/viewer.json, from scripts/viewer_fps.py)."""
+    runs = viewer["runs"]
+    rows = [["drawing only (`--paused`)" if r["run"] == "paused" else f"`{r['chapter']}`",
+             f"{r['frames_per_second']:.1f}", ms(r["mean_step_ms"]) if r["run"] != "paused" else "-"]
+            for r in runs]
+    first = runs[0]
+    mesh = pathlib.Path(first["mesh"]).name
+    return (table(["chapter", "frames/s", "mean step (ms)"], rows) +
+            f"\nMeasured by `./tutorial.sh viewer-bench`: {mesh} ({first['nodes']} nodes), "
+            f"{first['width']}x{first['height']}, {viewer['frames']} frames a run, one step per frame, "
+            f"renderer {first['renderer']}, {first['cpu']}, {first['compiler']} `{first['flags']}`, "
+            f"commit {viewer['commit']}.\n")
+
+
 def headline(data):
     by = chapters_by_name(data)
     base = by.get(BASELINE)
@@ -199,6 +214,7 @@ def main():
     parser.add_argument("--root", type=pathlib.Path, default=root_default, help="repository root")
     parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/results/bench.json")
     parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/results/scaling.json if present")
+    parser.add_argument("--viewer", type=pathlib.Path, help="default: ROOT/results/viewer.json if present")
     parser.add_argument("--images", type=pathlib.Path, nargs="?", const=pathlib.Path("docs/images"),
                         help="copy the PNG plots from the results directory here (default docs/images)")
     args = parser.parse_args()
@@ -208,15 +224,27 @@ def main():
     try:
         data = load_checked(bench_path)
         scaling = load_checked(scaling_path, scaling=True) if scaling_path.exists() else None
+        viewer_path = args.viewer or root / "results" / "viewer.json"
+        viewer = load_checked(viewer_path, viewer=True) if viewer_path.exists() else None
     except ResultsError as e:
         die(f"update_docs.py: {e}")
 
     solvers = solvers_table(data)
-    update_file(root / "docs" / "results.md", {
+    tables = {
         "results:machine": machine_table(data), "results:phases": phases_table(data),
         "results:speedups": speedups_table(data), "results:allocations": allocations_table(data),
-        "results:solvers": solvers, "results:scaling": scaling_table(scaling)})
-    update_file(root / "README.md", {"headline": headline(data), "chapter-map": chapter_map(data)})
+        "results:solvers": solvers}
+    # The scaling run takes tens of minutes and is optional: without results/scaling.json the
+    # committed table stays as it is (a placeholder goes in only where there is no table yet).
+    if scaling is not None or "run `./tutorial.sh scaling`" in (root / "docs" / "results.md").read_text():
+        tables["results:scaling"] = scaling_table(scaling)
+    else:
+        print("no results/scaling.json: the scaling table in docs/results.md is left as it is")
+    update_file(root / "docs" / "results.md", tables)
+    readme = {"headline": headline(data), "chapter-map": chapter_map(data)}
+    if viewer is not None:  # like the scaling table: optional, kept as it is without a new run
+        readme["viewer-fps"] = viewer_table(viewer)
+    update_file(root / "README.md", readme)
     for c in data["chapters"]:
         update_file(root / "chapters" / c["chapter"] / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),

@@ -17,6 +17,7 @@
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
+#include "common/json.hpp"
 
 namespace fv = fem::viewer;
 
@@ -88,6 +89,8 @@ std::string json_vector(const Eigen::Vector3d& v) {
 // The facts of a scripted run, for the smoke test and for the closing numbers.
 struct RunRecord {
   int frames = 0;
+  int width = 0, height = 0;  // of the framebuffer
+  bool paused = false;        // at the end of the run
   double seconds = 0.0;
   double step_seconds = 0.0;
   long long steps = 0;
@@ -99,9 +102,20 @@ void write_report(const std::string& path, const RunRecord& r, const fv::Session
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write the report " + path);
   out.precision(17);
-  out << "{\n  \"chapter\": \"" << session.chapter() << "\",\n  \"mesh\": \""
-      << session.scene().mesh.file << "\",\n  \"nodes\": " << session.scene().mesh.num_nodes()
-      << ",\n  \"frames\": " << r.frames << ",\n  \"seconds\": " << r.seconds
+  // What the frame rate depends on: the renderer (a GPU or Mesa's software llvmpipe), the
+  // CPU that steps and may also draw, and how the stepper was compiled.
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const fem::BuildInfo build = fem::build_info();
+  out << "{\n  \"chapter\": " << fem::json_string(session.chapter())
+      << ",\n  \"mesh\": " << fem::json_string(session.scene().mesh.file)
+      << ",\n  \"nodes\": " << session.scene().mesh.num_nodes()
+      << ",\n  \"paused\": " << (r.paused ? "true" : "false") << ",\n  \"width\": " << r.width
+      << ",\n  \"height\": " << r.height
+      << ",\n  \"renderer\": " << fem::json_string(renderer ? renderer : "unknown")
+      << ",\n  \"cpu\": " << fem::json_string(fem::cpu_model())
+      << ",\n  \"compiler\": " << fem::json_string(build.compiler)
+      << ",\n  \"flags\": " << fem::json_string(build.flags) << ",\n  \"frames\": " << r.frames
+      << ",\n  \"seconds\": " << r.seconds
       << ",\n  \"frames_per_second\": " << r.frames / std::max(r.seconds, 1e-9)
       << ",\n  \"steps\": " << r.steps
       << ",\n  \"mean_step_ms\": " << 1e3 * r.step_seconds / std::max<long long>(r.steps, 1)
@@ -287,6 +301,9 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
       write_screenshot(options.screenshot, width, height);
     glfwSwapBuffers(window);
     record.frames = frame + 1;
+    record.width = width;
+    record.height = height;
+    record.paused = panel.paused;
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("

@@ -16,7 +16,7 @@ SCRIPTS = ROOT / "scripts"
 FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
 sys.path.insert(0, str(SCRIPTS))
 import update_docs  # noqa: E402
-from results_common import validate_bench  # noqa: E402
+from results_common import validate_bench, validate_viewer  # noqa: E402
 
 results = {"passed": 0, "failed": 0}
 
@@ -43,6 +43,18 @@ def scaling_fixture(bench):
             "cg_tolerance": 1e-4, "build": bench["build"], "machine": bench["machine"],
             "commit": "fixture", "budget_seconds": 1.0, "runs": runs,
             "skipped": [{"chapter": "01_naive", "mesh": "beam_5000", "reason": "over 1 s"}]}
+
+
+def viewer_fixture(bench):
+    """A results/viewer.json as scripts/viewer_fps.py writes it, with made-up frame rates."""
+    def report(run, chapter, fps, step_ms):
+        return {"run": run, "chapter": chapter, "mesh": "meshes/test_beam.msh", "nodes": 123,
+                "frames": 100, "frames_per_second": fps, "mean_step_ms": step_ms, "width": 640,
+                "height": 480, "renderer": "llvmpipe (fixture)", "cpu": bench["machine"]["cpu"],
+                "compiler": bench["build"]["compiler"], "flags": bench["build"]["flags"]}
+    runs = [report("paused", "07_block_sparse", 31.25, 0.0)]
+    runs += [report(c["chapter"], c["chapter"], 5.5 + k, 100.0 / (k + 1)) for k, c in enumerate(bench["chapters"])]
+    return {"schema_version": 1, "commit": "fixture", "frames": 100, "runs": runs}
 
 
 def main():
@@ -73,6 +85,8 @@ def main():
         (root / "results").mkdir()
         shutil.copy(FIXTURE, root / "results" / "bench.json")
         shutil.copy(scaling, root / "results" / "scaling.json")
+        viewer = viewer_fixture(bench)
+        (root / "results" / "viewer.json").write_text(json.dumps(viewer))
         p = run(SCRIPTS / "update_docs.py", "--root", root)
         check("update_docs.py exits 0", p.returncode == 0, p.stderr)
         results_md = (root / "docs" / "results.md").read_text()
@@ -90,6 +104,11 @@ def main():
         check("results.md shows the scaling table", "stopped" in results_md)
         readme = (root / "README.md").read_text()
         check("README headline filled", update_docs.ms(last["median_ms"]["step"]) in readme)
+        check("README viewer table filled",
+              "| drawing only (`--paused`) | 31.2 | - |" in readme and "llvmpipe (fixture)" in readme and
+              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {update_docs.ms(r['mean_step_ms'])} |"
+                  in readme for r in viewer["runs"][1:]), readme[readme.find("viewer-fps"):][:600])
+        check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
         check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
 

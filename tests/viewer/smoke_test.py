@@ -53,6 +53,10 @@ def scripted_drag(viewer, mesh, out):
 
     facts = json.loads(report.read_text())
     check(facts["frames"] == FRAMES and facts["steps"] == FRAMES, "one step per frame")
+    check((facts["width"], facts["height"]) == (WIDTH, HEIGHT) and not facts["paused"],
+          f"the report records the {WIDTH}x{HEIGHT} framebuffer and a running simulation")
+    check(facts["renderer"] not in ("", "unknown") and facts["compiler"] and facts["cpu"],
+          f"the report names what the frame rate depends on: {facts['renderer']}, {facts['cpu']}")
     check(facts["grabbed_node"] >= 0, f"the drag grabbed surface node {facts['grabbed_node']}")
     grab, target, end = (np.array(facts[k]) for k in ("node_at_grab", "target", "node_at_end"))
     pull = target - grab
