@@ -92,9 +92,9 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
       alloc::Scope counter;
       run.stepper->step(run.state);
       const long long allocs = counter.allocations();
-      if (!run.state.x.allFinite())
+      if (const char* why = divergence(run.state, run.stepper->profile()))
         throw std::runtime_error(run.chapter->id + ": the simulation diverged at step " +
-                                 std::to_string(k + 1) + " (non-finite positions)");
+                                 std::to_string(k + 1) + " (" + why + ")");
       if (k < warmup) continue;
       ChapterResult& r = run.result;
       const StepProfile& p = run.stepper->profile();

@@ -44,9 +44,10 @@ int main(int argc, char** argv) {
     const int report_every = std::max(1, steps / 10);
     for (int k = 1; k <= steps; ++k) {
       stepper->step(state);
-      if (!state.x.allFinite() || !state.v.allFinite())
-        throw std::runtime_error("the simulation diverged at step " + std::to_string(k) +
-                                 " (non-finite positions); try a smaller --dt or a softer --E");
+      if (const char* why = divergence(state, stepper->profile()))
+        throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" +
+                                 why +
+                                 "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
       if (every > 0 && k % every == 0)
         series.write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
       if (k % report_every == 0 || k == steps) {

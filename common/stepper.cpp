@@ -1,5 +1,6 @@
 #include "common/stepper.hpp"
 
+#include <cmath>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -33,10 +34,22 @@ void report_if_not_converged(const StepProfile& profile, const SolverSettings& s
                              const char* chapter, bool& already_warned) {
   if (profile.converged || already_warned) return;
   already_warned = true;
-  std::cerr << "warning: " << chapter << ": the linear solve stopped at the iteration cap ("
-            << settings.max_iterations << ") with relative residual " << profile.relative_residual
-            << " > tolerance " << settings.tolerance
-            << " (reported once; see StepProfile::converged for every step)\n";
+  std::cerr << "warning: " << chapter << ": ";
+  if (std::isfinite(profile.relative_residual))
+    std::cerr << "the linear solve stopped at the iteration cap (" << settings.max_iterations
+              << ") with relative residual " << profile.relative_residual << " > tolerance "
+              << settings.tolerance;
+  else
+    std::cerr << "the linear solve broke down after " << profile.cg_iterations
+              << " iterations (non-finite residual)";
+  std::cerr << " (reported once; see StepProfile::converged for every step)\n";
+}
+
+const char* divergence(const State& state, const StepProfile& profile) {
+  if (!state.x.allFinite() || !state.v.allFinite()) return "non-finite positions or velocities";
+  if (!std::isfinite(profile.relative_residual))
+    return "the linear solve's residual is not finite: the system overflows";
+  return nullptr;
 }
 
 }  // namespace fem

@@ -91,4 +91,10 @@ namespace fem {
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
                              const char* chapter, bool& already_warned);
 
+// Why the last step cannot be trusted, or nullptr when it can: non-finite positions or
+// velocities, or a solve whose residual is not finite. The second happens when the system
+// overflows (an absurd E or dt): CG then stops at once and leaves the state finite but
+// frozen, which a check of the positions alone would let pass silently.
+const char* divergence(const State& state, const StepProfile& profile);
+
 }  // namespace fem

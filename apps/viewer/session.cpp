@@ -80,9 +80,9 @@ bool Session::step() {
   forces_.insert(forces_.end(), spring.begin(), spring.end());
   stepper_->set_external_forces(forces_);
   stepper_->step(state_);
-  if (!state_.x.allFinite() || !state_.v.allFinite()) {
-    message_ = "the simulation diverged at t = " + std::to_string(time_) +
-               " s and was reset: try a smaller dt, a softer spring or more damping";
+  if (const char* why = divergence(state_, stepper_->profile())) {
+    message_ = "the simulation diverged at t = " + std::to_string(time_) + " s (" + why +
+               ") and was reset: try a smaller dt, a softer spring or more damping";
     reset();
     return false;
   }
