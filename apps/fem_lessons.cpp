@@ -12,6 +12,8 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "chapters/02_noalias/statements.hpp"
 #include "chapters/06_custom_pcg/stepper.hpp"
@@ -212,29 +214,21 @@ void write_between_markers(const std::string& path, const std::string& name,
   std::ofstream(path) << doc;
 }
 
-}  // namespace
+const char* const kUsage =
+    "usage: fem_lessons [noalias|dfdx-fill|spmv [options]]\n"
+    "  noalias    allocations of each vector statement of chapter 01 and its chapter 02 rewrite\n"
+    "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n"
+    "  spmv       SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi\n"
+    "without a lesson: every lesson in turn, with its defaults\n";
 
-int main(int argc, char** argv) {
-  const std::string usage =
-      "usage: fem_lessons noalias|dfdx-fill|spmv [options]\n"
-      "  noalias    allocations of each vector statement of chapter 01 and its chapter 02 rewrite\n"
-      "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n"
-      "  spmv       SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi\n";
-  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    std::cout << usage << "(fem_lessons LESSON --help for the options)\n";
-    return argc < 2 ? 2 : 0;
-  }
-  const std::string lesson = argv[1];
-  if (lesson != "noalias" && lesson != "dfdx-fill" && lesson != "spmv") {
-    std::cerr << "fem_lessons: unknown lesson '" << lesson << "'\n" << usage;
-    return 2;
-  }
+// One lesson with its options (argv[0] is the lesson's name); returns the exit status.
+int run_lesson(const std::string& lesson, int argc, char** argv) {
   ArgParser args("fem_lessons " + lesson, "Prints the lesson's table in Markdown.");
   add_scene_options(args, lesson == "noalias" ? "meshes/test_beam.msh" : "meshes/plate_poster.msh");
   args.option("steps", "N", "measured steps (dfdx-fill)", "50");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
   try {
-    if (!args.parse(argc - 1, argv + 1)) return 0;
+    if (!args.parse(argc, argv)) return 0;
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
@@ -254,4 +248,28 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> lessons = {"noalias", "dfdx-fill", "spmv"};
+  if (argc < 2) {  // every lesson, as the README of its chapter shows it
+    for (const std::string& lesson : lessons) {
+      std::cout << "\n## fem_lessons " << lesson << "\n\n" << std::flush;
+      char* lesson_argv[] = {argv[0]};
+      if (const int status = run_lesson(lesson, 1, lesson_argv); status != 0) return status;
+    }
+    return 0;
+  }
+  const std::string first = argv[1];
+  if (first == "--help" || first == "-h") {
+    std::cout << kUsage << "(fem_lessons LESSON --help for the options)\n";
+    return 0;
+  }
+  if (std::find(lessons.begin(), lessons.end(), first) == lessons.end()) {
+    std::cerr << "fem_lessons: unknown lesson '" << first << "'\n" << kUsage;
+    return 2;
+  }
+  return run_lesson(first, argc - 1, argv + 1);
 }
