@@ -39,7 +39,10 @@ def run_one(viewer, mesh, chapter, frames, size, report):
            "--frames", str(frames), "--width", str(size[0]), "--height", str(size[1]),
            "--report", str(report)]
     cmd += ["--paused"] if chapter == PAUSED else ["--chapter", chapter]
-    run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    try:
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    except subprocess.TimeoutExpired:
+        raise SystemExit(f"viewer_fps.py: {' '.join(cmd)} did not finish in 10 minutes") from None
     if run.returncode != 0:
         raise SystemExit(f"viewer_fps.py: {' '.join(cmd)} failed ({run.returncode}):\n{run.stderr}")
     return json.loads(report.read_text())
@@ -56,10 +59,9 @@ def main():
     args = parser.parse_args()
     if args.frames < 10:
         parser.error("--frames must be at least 10 (the first frames set up the GL state)")
-    try:
-        size = tuple(int(v) for v in args.size.split("x"))
-        assert len(size) == 2 and min(size) >= 64
-    except (ValueError, AssertionError):
+    parts = args.size.split("x")
+    size = tuple(int(v) for v in parts) if len(parts) == 2 and all(v.isdigit() for v in parts) else ()
+    if not size or min(size) < 64:
         parser.error(f"--size must be WIDTHxHEIGHT, at least 64x64 (got '{args.size}')")
     if not pathlib.Path(args.viewer).exists():
         sys.exit(f"viewer_fps.py: {args.viewer} does not exist (was fem_viewer built? see the CMake warning)")
