@@ -65,10 +65,10 @@ ch10::MultigridSettings multigrid_from_args(const ArgParser& args) {
     throw UsageError("--smoother must be gs or jacobi");
   s.sweeps = args.get_int("sweeps");
   const std::string prolongator = args.get("prolongator");
-  if (prolongator != "smoothed" && prolongator != "frozen" && prolongator != "tentative")
-    throw UsageError("--prolongator must be smoothed, frozen or tentative");
+  if (prolongator != "every-step" && prolongator != "frozen" && prolongator != "tentative")
+    throw UsageError("--prolongator must be frozen, every-step or tentative");
   s.smooth_prolongator = prolongator != "tentative";
-  s.update_prolongator = prolongator == "smoothed";
+  s.update_prolongator = prolongator == "every-step";
   s.max_coarse_dofs = args.get_int("max-coarse");
   if (s.modes != 3 && s.modes != 6) throw UsageError("--modes must be 3 or 6");
   if (s.sweeps < 1) throw UsageError("--sweeps must be at least 1");
@@ -224,8 +224,9 @@ int main(int argc, char** argv) {
   args.option("smoother", "NAME", "gs (symmetric block Gauss-Seidel) or jacobi", "gs");
   args.option("sweeps", "N", "pre- and post-smoothing sweeps", "1");
   args.option("prolongator", "KIND",
-              "smoothed (every step), frozen (first step's) or tentative (unsmoothed)",
-              "smoothed");
+              "frozen (smoothed on the first step), every-step (smoothed every step) or "
+              "tentative (unsmoothed)",
+              "frozen");
   args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns", "200");
   args.option("export", "DIR", "write the last filtered system as Matrix Market into DIR", "");
   try {

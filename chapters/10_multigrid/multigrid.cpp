@@ -226,11 +226,22 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
   for (auto& row : coarse_rows) sort_unique(row);
   coarse.A = from_rows<kModes, kModes>(coarse_rows);
   coarse.values = coarse.A.blocks.data();
+  fine.galerkin_first.resize(P.column.size());
   fine.galerkin_target.clear();
   for (int i = 0; i < n; ++i)
-    for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
-      for (int q = AP.row_start[i]; q < AP.row_start[i + 1]; ++q)
+    for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m) {
+      const auto first = AP.column.begin() + AP.row_start[i],
+                 last = AP.column.begin() + AP.row_start[i + 1];
+      fine.galerkin_first[m] =
+          static_cast<int>(std::lower_bound(first, last, P.column[m]) - AP.column.begin());
+      for (int q = fine.galerkin_first[m]; q < AP.row_start[i + 1]; ++q)
         fine.galerkin_target.push_back(coarse.A.find(P.column[m], AP.column[q]));
+    }
+  fine.galerkin_mirror.clear();
+  for (int c = 0; c < count; ++c)
+    for (int k = coarse.A.row_start[c]; k < coarse.A.row_start[c + 1]; ++k)
+      if (coarse.A.column[k] < c)
+        fine.galerkin_mirror.push_back({k, coarse.A.find(coarse.A.column[k], c)});
   set_diagonal(coarse);
 }
 
@@ -243,16 +254,30 @@ void finish_coarsest(Level<B>& level) {
 
 // ---- the numbers of one level -------------------------------------------------------------
 
+// sum of A_k x_(column k) over the blocks [begin, end) of a row, in two independent sums: the
+// products of a row then overlap instead of waiting on each other's additions. That matters
+// most in Gauss-Seidel, where a row cannot finish before the previous row's x_i is written.
+template <int B>
+Eigen::Matrix<double, B, 1> row_product(const Level<B>& level, const Eigen::VectorXd& x, int begin,
+                                        int end) {
+  using Vector = Eigen::Matrix<double, B, 1>;
+  Vector even = Vector::Zero(), odd = Vector::Zero();
+  const int* column = level.A.column.data();
+  int k = begin;
+  for (; k + 1 < end; k += 2) {
+    even.noalias() += level.values[k] * x.template segment<B>(B * column[k]);
+    odd.noalias() += level.values[k + 1] * x.template segment<B>(B * column[k + 1]);
+  }
+  if (k < end) even.noalias() += level.values[k] * x.template segment<B>(B * column[k]);
+  return even + odd;
+}
+
 // y = A x on a level, one block row at a time.
 template <int B>
 void multiply(const Level<B>& level, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   const auto& A = level.A;
-  for (int i = 0; i < level.nodes(); ++i) {
-    Eigen::Matrix<double, B, 1> sum = Eigen::Matrix<double, B, 1>::Zero();
-    for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
-      sum.noalias() += level.values[k] * x.template segment<B>(B * A.column[k]);
-    y.template segment<B>(B * i) = sum;
-  }
+  for (int i = 0; i < level.nodes(); ++i)
+    y.template segment<B>(B * i) = row_product(level, x, A.row_start[i], A.row_start[i + 1]);
 }
 
 // The largest eigenvalue of D^-1 A by power iteration from a fixed start (deterministic),
@@ -316,8 +341,10 @@ void galerkin_product(Level<B>& level, Level<kModes>& coarse) {
   target = level.galerkin_target.data();
   for (int i = 0; i < level.nodes(); ++i)
     for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
-      for (int q = AP.row_start[i]; q < AP.row_start[i + 1]; ++q)
+      for (int q = level.galerkin_first[m]; q < AP.row_start[i + 1]; ++q)
         coarse.A.blocks[*target++].noalias() += P.blocks[m].transpose() * AP.blocks[q];
+  for (const auto& [lower, upper] : level.galerkin_mirror)
+    coarse.A.blocks[lower] = coarse.A.blocks[upper].transpose();
   for (int c = 0; c < coarse.nodes(); ++c)
     coarse.A.blocks[coarse.diagonal[c]].diagonal() += coarse.unused[c];
 }
@@ -332,10 +359,22 @@ void gauss_seidel(const Level<B>& level, const Eigen::VectorXd& b, Eigen::Vector
   const int n = level.nodes();
   for (int s = 0; s < n; ++s) {
     const int i = forward ? s : n - 1 - s;
-    Eigen::Matrix<double, B, 1> r = b.template segment<B>(B * i);
-    for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
-      r.noalias() -= level.values[k] * x.template segment<B>(B * A.column[k]);
+    const Eigen::Matrix<double, B, 1> r =
+        b.template segment<B>(B * i) - row_product(level, x, A.row_start[i], A.row_start[i + 1]);
     x.template segment<B>(B * i).noalias() += level.inverse_diagonal[i] * r;
+  }
+}
+
+// The first forward sweep from x = 0: the blocks right of the diagonal multiply zeros, so
+// only the lower half is read. Afterwards b - A x is exactly -(strictly upper part) x, the
+// other half: smoothing and residual together cost one SpMV instead of two.
+template <int B>
+void gauss_seidel_from_zero(const Level<B>& level, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  const auto& A = level.A;
+  for (int i = 0; i < level.nodes(); ++i) {
+    const Eigen::Matrix<double, B, 1> r =
+        b.template segment<B>(B * i) - row_product(level, x, A.row_start[i], level.diagonal[i]);
+    x.template segment<B>(B * i).noalias() = level.inverse_diagonal[i] * r;
   }
 }
 
@@ -455,19 +494,36 @@ void Multigrid::cycle(Level<B>& level, std::size_t next, const Eigen::VectorXd& 
     return;
   }
   const bool gauss_seidel_smoother = settings_.smoother == MultigridSettings::Smoother::GaussSeidel;
-  x.setZero();
-  for (int s = 0; s < settings_.sweeps; ++s)
-    gauss_seidel_smoother ? gauss_seidel(level, b, x, true) : jacobi(level, b, x);
+  const auto& A = level.A;
+  if (gauss_seidel_smoother) {
+    gauss_seidel_from_zero(level, b, x);
+    for (int s = 1; s < settings_.sweeps; ++s) gauss_seidel(level, b, x, true);
+  } else {
+    x.setZero();
+    for (int s = 0; s < settings_.sweeps; ++s) jacobi(level, b, x);
+  }
+  // After one sweep from zero the residual is the upper half's product, computed row by row
+  // below; otherwise a full product first.
+  const bool upper_residual = gauss_seidel_smoother && settings_.sweeps == 1;
+  if (!upper_residual) {
+    multiply(level, x, level.work);
+    level.work = b - level.work;
+  }
   // Restrict the residual: b_c = P^T (b - A x).
-  multiply(level, x, level.work);
-  level.work = b - level.work;
   Level<kModes>& coarse = coarse_[next];
   coarse.b.setZero();
   const auto& P = level.P;
-  for (int i = 0; i < level.nodes(); ++i)
+  for (int i = 0; i < level.nodes(); ++i) {
+    Eigen::Matrix<double, B, 1> r;
+    if (upper_residual) {
+      r = -row_product(level, x, level.diagonal[i] + 1, A.row_start[i + 1]);
+    } else {
+      r = level.work.template segment<B>(B * i);
+    }
     for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
       coarse.b.template segment<kModes>(kModes * P.column[m]).noalias() +=
-          P.blocks[m].transpose() * level.work.template segment<B>(B * i);
+          P.blocks[m].transpose() * r;
+  }
   cycle(coarse, next + 1, coarse.b, coarse.x);
   // Prolong the correction: x += P x_c.
   for (int i = 0; i < level.nodes(); ++i) {

@@ -15,6 +15,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -47,7 +48,7 @@ struct MultigridSettings {
   int sweeps = 1;             // pre- and post-smoothing sweeps per level
   double jacobi_weight = 0.0; // damped block-Jacobi smoother: 0 means 1 / rho(D^-1 A)
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
-  bool update_prolongator = true;   // recompute P's values every step (false: first step's)
+  bool update_prolongator = false;  // recompute P every step (default: the first step's)
   int power_iterations = 10;        // estimate of rho(D^-1 A) for the prolongator smoother
   int max_coarse_dofs = 200;        // the dense Cholesky's size limit
   int max_levels = 8;
@@ -76,7 +77,12 @@ struct Level {
   std::vector<int> at_target;          // per block k of A: where A_k T_j lands in P
   BlockCsr<B, kModes> AP;              // A P
   std::vector<int> ap_target;          // per product A_k P_m, in loop order
-  std::vector<int> galerkin_target;    // per product P_m^T (AP)_n, in loop order
+  // A_c is symmetric: only its blocks (c, d) with d >= c are computed. Per block m of P (in
+  // row i, column c), the first block of row i of A P with a column >= c; the targets of
+  // those products in loop order; and the (lower, upper) pairs copied by transposition.
+  std::vector<int> galerkin_first;
+  std::vector<int> galerkin_target;
+  std::vector<std::array<int, 2>> galerkin_mirror;
   double omega = 0.0;                  // prolongator smoothing weight 4 / (3 rho)
   double jacobi_weight = 0.0;          // smoother weight (Jacobi smoother)
 
