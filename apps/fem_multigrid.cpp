@@ -131,8 +131,11 @@ int run(const ArgParser& args) {
   for (int l = 0; l < mg.levels(); ++l) {
     const int block = l == 0 ? 3 : 6;
     std::cout << "  level " << l << ": " << std::setw(7) << mg.level_dofs(l) << " unknowns, "
-              << std::setw(8) << mg.level_blocks(l) << " blocks of " << block << "x" << block
-              << "\n";
+              << std::setw(8) << mg.level_blocks(l) << " blocks of " << block << "x" << block;
+    if (l + 1 < mg.levels())
+      std::cout << ", P " << std::setw(7) << mg.prolongator_blocks(l) << " blocks of " << block
+                << "x6";
+    std::cout << "\n";
     blocks += mg.level_blocks(l) * block * block;
     if (l == 0) fine_blocks = blocks;
   }

@@ -58,42 +58,52 @@ Eigen::SparseMatrix<double> to_sparse(const BlockCsr<R, C>& pattern, const Value
 }
 
 // Standard aggregation (Vanek, Mandel & Brezina 1996; PyAMG's standard_aggregation) with
-// every connection of the pattern strong: PyAMG's default strength for smoothed aggregation
+// every connection of the graph strong: PyAMG's default strength for smoothed aggregation
 // is symmetric with theta = 0, which keeps all of them. So aggregates depend on the mesh
-// alone and are built once.
-template <int B>
-std::vector<int> aggregate_nodes(const BlockCsr<B, B>& A, int& count) {
-  const int n = A.block_rows();
+// alone and are built once. graph[i] lists i's neighbours (i included).
+std::vector<int> aggregate_nodes(const Rows& graph, int& count) {
+  const int n = static_cast<int>(graph.size());
   std::vector<int> aggregate(n, -1);
   count = 0;
   // 1: a node whose neighbours are all unaggregated seeds an aggregate with them.
   for (int i = 0; i < n; ++i) {
     if (aggregate[i] != -1) continue;
-    bool free = true;
-    for (int k = A.row_start[i]; k < A.row_start[i + 1] && free; ++k)
-      free = aggregate[A.column[k]] == -1;
+    const bool free = std::all_of(graph[i].begin(), graph[i].end(),
+                                  [&](int j) { return aggregate[j] == -1; });
     if (!free) continue;
-    for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k) aggregate[A.column[k]] = count;
+    for (const int j : graph[i]) aggregate[j] = count;
     aggregate[i] = count++;
   }
   // 2: the rest join a neighbouring aggregate of step 1.
   const std::vector<int> seeded = aggregate;
   for (int i = 0; i < n; ++i) {
     if (aggregate[i] != -1) continue;
-    for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
-      if (seeded[A.column[k]] != -1) {
-        aggregate[i] = seeded[A.column[k]];
+    for (const int j : graph[i])
+      if (seeded[j] != -1) {
+        aggregate[i] = seeded[j];
         break;
       }
   }
   // 3: whatever is left (no aggregated neighbour) forms aggregates of its own.
   for (int i = 0; i < n; ++i) {
     if (aggregate[i] != -1) continue;
-    for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
-      if (aggregate[A.column[k]] == -1) aggregate[A.column[k]] = count;
+    for (const int j : graph[i])
+      if (aggregate[j] == -1) aggregate[j] = count;
     aggregate[i] = count++;
   }
   return aggregate;
+}
+
+// The graph of the aggregates: two are neighbours when two of their nodes are. This, not the
+// pattern of P^T A P (which also links aggregates two and three nodes apart), is what the next
+// level aggregates: on the wider pattern its aggregates become so large (about 40 aggregates
+// each on a 10k-node beam) that the coarsest level no longer represents the one above.
+Rows aggregate_graph(const Rows& graph, const std::vector<int>& aggregate, int count) {
+  Rows coarse(count);
+  for (std::size_t i = 0; i < graph.size(); ++i)
+    for (const int j : graph[i]) coarse[aggregate[i]].push_back(aggregate[j]);
+  for (auto& row : coarse) sort_unique(row);
+  return coarse;
 }
 
 // The near-null space of elasticity at the nodes: the 3 translations and the 3 rotations
@@ -177,6 +187,7 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
                     int count, bool smooth, Level<kModes>& coarse,
                     std::vector<Matrix6d>& coarse_modes) {
   fine.coarsest = false;
+  coarse.graph = aggregate_graph(fine.graph, fine.aggregate, count);
   tentative_prolongator<B>(modes, fine.aggregate, count, fine.tentative, coarse_modes,
                            coarse.unused);
   const auto& A = fine.A;
@@ -215,7 +226,10 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
   for (int i = 0; i < n; ++i)
     for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
       for (int m = P.row_start[A.column[k]]; m < P.row_start[A.column[k] + 1]; ++m)
-        fine.ap_target.push_back(fine.AP.find(i, P.column[m]));
+        fine.ap_target.push_back(fine.AP.find(i, P.column[m]) - fine.AP.row_start[i]);
+  std::size_t longest = 0;  // A P's blocks: one row's worth, reused row after row
+  for (const auto& r : rows) longest = std::max(longest, r.size());
+  fine.AP.blocks.resize(longest);
 
   const auto& AP = fine.AP;
   Rows coarse_rows(count);
@@ -258,7 +272,8 @@ void finish_coarsest(Level<B>& level) {
 // products of a row then overlap instead of waiting on each other's additions. That matters
 // most in Gauss-Seidel, where a row cannot finish before the previous row's x_i is written.
 template <int B>
-Eigen::Matrix<double, B, 1> row_product(const Level<B>& level, const Eigen::VectorXd& x, int begin,
+EIGEN_STRONG_INLINE Eigen::Matrix<double, B, 1> row_product(const Level<B>& level,
+                                                            const Eigen::VectorXd& x, int begin,
                                         int end) {
   using Vector = Eigen::Matrix<double, B, 1>;
   Vector even = Vector::Zero(), odd = Vector::Zero();
@@ -329,20 +344,24 @@ void galerkin_product(Level<B>& level, Level<kModes>& coarse) {
   const auto& A = level.A;
   const auto& P = level.P;
   auto& AP = level.AP;
-  for (auto& block : AP.blocks) block.setZero();
-  const int* target = level.ap_target.data();
-  for (int i = 0; i < level.nodes(); ++i)
+  // One row of A P at a time, in a buffer that stays in cache: row i of A P is needed only
+  // by row i's products P_i^T (A P)_i, so the whole of A P is never stored.
+  auto* row = AP.blocks.data();
+  for (auto& block : coarse.A.blocks) block.setZero();
+  const int* ap_target = level.ap_target.data();
+  const int* target = level.galerkin_target.data();
+  for (int i = 0; i < level.nodes(); ++i) {
+    const int first = AP.row_start[i], length = AP.row_start[i + 1] - first;
+    for (int q = 0; q < length; ++q) row[q].setZero();
     for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k) {
       const int j = A.column[k];
       for (int m = P.row_start[j]; m < P.row_start[j + 1]; ++m)
-        AP.blocks[*target++].noalias() += level.values[k] * P.blocks[m];
+        row[*ap_target++].noalias() += level.values[k] * P.blocks[m];
     }
-  for (auto& block : coarse.A.blocks) block.setZero();
-  target = level.galerkin_target.data();
-  for (int i = 0; i < level.nodes(); ++i)
     for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
-      for (int q = level.galerkin_first[m]; q < AP.row_start[i + 1]; ++q)
-        coarse.A.blocks[*target++].noalias() += P.blocks[m].transpose() * AP.blocks[q];
+      for (int q = level.galerkin_first[m] - first; q < length; ++q)
+        coarse.A.blocks[*target++].noalias() += P.blocks[m].transpose() * row[q];
+  }
   for (const auto& [lower, upper] : level.galerkin_mirror)
     coarse.A.blocks[lower] = coarse.A.blocks[upper].transpose();
   for (int c = 0; c < coarse.nodes(); ++c)
@@ -422,7 +441,10 @@ Multigrid::Multigrid(const std::vector<int>& row_start, const std::vector<int>& 
     return dofs > settings_.max_coarse_dofs && levels() < settings_.max_levels &&
            aggregates < nodes;
   };
-  fine_.aggregate = aggregate_nodes(fine_.A, count);
+  fine_.graph.resize(fine_.nodes());
+  for (int i = 0; i < fine_.nodes(); ++i)
+    fine_.graph[i].assign(column.begin() + row_start[i], column.begin() + row_start[i + 1]);
+  fine_.aggregate = aggregate_nodes(fine_.graph, count);
   if (!worth_coarsening(fine_.dofs(), fine_.nodes(), count)) {
     finish_coarsest(fine_);
     return;
@@ -434,7 +456,7 @@ Multigrid::Multigrid(const std::vector<int>& row_start, const std::vector<int>& 
   while (true) {
     Level<kModes>& level = coarse_.back();
     start_vector(level.start, level.dofs());
-    level.aggregate = aggregate_nodes(level.A, count);
+    level.aggregate = aggregate_nodes(level.graph, count);
     if (!worth_coarsening(level.dofs(), level.nodes(), count)) break;
     const std::vector<Matrix6d> level_modes = modes;
     coarse_.emplace_back();
@@ -547,6 +569,11 @@ int Multigrid::level_dofs(int level) const {
 long long Multigrid::level_blocks(int level) const {
   return static_cast<long long>(level == 0 ? fine_.A.column.size()
                                            : coarse_.at(level - 1).A.column.size());
+}
+
+long long Multigrid::prolongator_blocks(int level) const {
+  return static_cast<long long>(level == 0 ? fine_.P.column.size()
+                                           : coarse_.at(level - 1).P.column.size());
 }
 
 Eigen::SparseMatrix<double> Multigrid::level_matrix(int level) const {

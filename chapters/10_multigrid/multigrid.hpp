@@ -70,13 +70,14 @@ struct Level {
   std::vector<Eigen::Matrix<double, B, 1>> unused;
 
   bool coarsest = true;  // no transfer below: solved by the dense Cholesky
-  std::vector<int> aggregate;          // per node: its aggregate (coarse node)
+  std::vector<std::vector<int>> graph;  // the neighbours that aggregation considers
+  std::vector<int> aggregate;           // per node: its aggregate (coarse node)
   std::vector<Transfer> tentative;     // per node: its block of T
   BlockCsr<B, kModes> P;               // smoothed prolongator, pattern of A T
   std::vector<int> tentative_block;    // per node: index of (i, aggregate[i]) in P
   std::vector<int> at_target;          // per block k of A: where A_k T_j lands in P
-  BlockCsr<B, kModes> AP;              // A P
-  std::vector<int> ap_target;          // per product A_k P_m, in loop order
+  BlockCsr<B, kModes> AP;              // the pattern of A P; blocks: one row's buffer
+  std::vector<int> ap_target;          // per product A_k P_m, in loop order: its place in the row
   // A_c is symmetric: only its blocks (c, d) with d >= c are computed. Per block m of P (in
   // row i, column c), the first block of row i of A P with a column >= c; the targets of
   // those products in loop order; and the (lower, upper) pairs copied by transposition.
@@ -114,6 +115,7 @@ class Multigrid {
   int levels() const { return 1 + static_cast<int>(coarse_.size()); }
   int level_dofs(int level) const;
   long long level_blocks(int level) const;  // stored blocks of the level's matrix
+  long long prolongator_blocks(int level) const;  // blocks of P from level to level + 1
   // For tests and reports (allocate): level matrices, prolongators from level to level + 1,
   // and the identity diagonal added on the unused modes of level (level >= 1).
   Eigen::SparseMatrix<double> level_matrix(int level) const;
