@@ -272,7 +272,7 @@ void finish_coarsest(Level<B>& level) {
 // products of a row then overlap instead of waiting on each other's additions. That matters
 // most in Gauss-Seidel, where a row cannot finish before the previous row's x_i is written.
 template <int B>
-EIGEN_STRONG_INLINE Eigen::Matrix<double, B, 1> row_product(const Level<B>& level,
+EIGEN_ALWAYS_INLINE Eigen::Matrix<double, B, 1> row_product(const Level<B>& level,
                                                             const Eigen::VectorXd& x, int begin,
                                         int end) {
   using Vector = Eigen::Matrix<double, B, 1>;
