@@ -31,9 +31,13 @@ Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
 
 // The test mesh is small (190 nodes): a coarse limit below the default gives it the three
 // levels a poster-sized mesh has, so that every code path of the V-cycle runs.
-ch10::MultigridSettings three_levels() {
+using Smoother = ch10::MultigridSettings::Smoother;
+constexpr Smoother kSmoothers[] = {Smoother::GaussSeidel, Smoother::Jacobi};
+
+ch10::MultigridSettings three_levels(Smoother smoother = Smoother::GaussSeidel) {
   ch10::MultigridSettings s;
   s.max_coarse_dofs = 24;
+  s.smoother = smoother;
   return s;
 }
 
@@ -45,11 +49,8 @@ TEST_CASE("ch10: matches chapter 01 on every scene over 50 steps", "[ch10]") {
 
 TEST_CASE("ch10: the V-cycle is symmetric positive definite on the filtered space", "[ch10]") {
   for (const Scene& scene : all_scenes()) {
-    for (const auto smoother : {ch10::MultigridSettings::Smoother::GaussSeidel,
-                                ch10::MultigridSettings::Smoother::Jacobi}) {
-      ch10::MultigridSettings settings = three_levels();
-      settings.smoother = smoother;
-      ch10::MultigridStepper stepper(scene, {}, settings);
+    for (const Smoother smoother : kSmoothers) {
+      ch10::MultigridStepper stepper(scene, {}, three_levels(smoother));
       State state = rest_state(scene);
       for (int k = 0; k < 3; ++k) stepper.step(state);
       ch10::Multigrid& mg = stepper.multigrid();
@@ -150,11 +151,8 @@ TEST_CASE("ch10: zero heap allocations per step after the first", "[ch10][alloc]
     INFO(scene.name);
     CHECK(test::allocations_per_step("10", scene) == 0);
     // The three-level hierarchy too, with either smoother.
-    for (const auto smoother : {ch10::MultigridSettings::Smoother::GaussSeidel,
-                                ch10::MultigridSettings::Smoother::Jacobi}) {
-      ch10::MultigridSettings settings = three_levels();
-      settings.smoother = smoother;
-      ch10::MultigridStepper stepper(scene, {}, settings);
+    for (const Smoother smoother : kSmoothers) {
+      ch10::MultigridStepper stepper(scene, {}, three_levels(smoother));
       State state = rest_state(scene);
       stepper.step(state);
       alloc::Scope scope;
