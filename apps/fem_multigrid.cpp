@@ -70,6 +70,8 @@ ch10::MultigridSettings multigrid_from_args(const ArgParser& args) {
   s.smooth_prolongator = prolongator != "tentative";
   s.update_prolongator = prolongator == "every-step";
   s.max_coarse_dofs = args.get_int("max-coarse");
+  s.coarse_refresh = args.get_int("coarse-every");
+  if (s.coarse_refresh < 1) throw UsageError("--coarse-every must be at least 1");
   if (s.modes != 3 && s.modes != 6) throw UsageError("--modes must be 3 or 6");
   if (s.sweeps < 1) throw UsageError("--sweeps must be at least 1");
   if (s.max_coarse_dofs < 6) throw UsageError("--max-coarse must be at least 6");
@@ -231,6 +233,7 @@ int main(int argc, char** argv) {
               "tentative (unsmoothed)",
               "frozen");
   args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns", "200");
+  args.option("coarse-every", "K", "recompute the coarse matrices every K-th step", "1");
   args.option("export", "DIR", "write the last filtered system as Matrix Market into DIR", "");
   try {
     if (!args.parse(argc, argv)) return 0;

@@ -418,8 +418,10 @@ Multigrid::Multigrid(const std::vector<int>& row_start, const std::vector<int>& 
     : settings_(settings) {
   if (settings_.modes != 3 && settings_.modes != kModes)
     throw std::invalid_argument("multigrid: modes must be 3 or 6");
-  if (settings_.sweeps < 1 || settings_.max_levels < 1 || settings_.power_iterations < 1)
-    throw std::invalid_argument("multigrid: sweeps, levels and power iterations must be >= 1");
+  if (settings_.sweeps < 1 || settings_.max_levels < 1 || settings_.power_iterations < 1 ||
+      settings_.coarse_refresh < 1)
+    throw std::invalid_argument(
+        "multigrid: sweeps, levels, power iterations and coarse refresh must be >= 1");
   fine_.A.row_start = row_start;
   fine_.A.column = column;
   if (rest_positions.size() != 3 * fine_.nodes())
@@ -497,6 +499,11 @@ void Multigrid::prepare(const std::vector<Eigen::Matrix3d>& fine_blocks) {
   if (fine_blocks.size() != fine_.A.column.size())
     throw std::invalid_argument("multigrid: the matrix does not have the set-up pattern");
   fine_.values = fine_blocks.data();
+  if (prepares_++ % settings_.coarse_refresh != 0 && !fine_.coarsest) {
+    for (int i = 0; i < fine_.nodes(); ++i)
+      fine_.inverse_diagonal[i] = fine_.values[fine_.diagonal[i]].inverse();
+    return;
+  }
   prepare_level(fine_, 0);
   for (std::size_t l = 0; l < coarse_.size(); ++l) prepare_level(coarse_[l], l + 1);
   prolongators_ready_ = true;

@@ -50,6 +50,9 @@ struct MultigridSettings {
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
   bool update_prolongator = false;  // recompute P every step (default: the first step's)
   int power_iterations = 10;        // estimate of rho(D^-1 A) for the prolongator smoother
+  // Coarse matrices recomputed every k-th prepare (1: every step). In between, only the finest
+  // level follows the new matrix; the V-cycle stays SPD, only its quality can suffer.
+  int coarse_refresh = 1;
   int max_coarse_dofs = 200;        // the dense Cholesky's size limit
   int max_levels = 8;
 };
@@ -132,6 +135,7 @@ class Multigrid {
   Level<3> fine_;
   std::vector<Level<kModes>> coarse_;
   bool prolongators_ready_ = false;
+  long long prepares_ = 0;
 };
 
 }  // namespace fem::ch10
