@@ -171,3 +171,33 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   bad.modes = 4;
   CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
 }
+
+TEST_CASE("ch10: coarse matrices kept for several steps give the same motion", "[ch10]") {
+  // A lagged V-cycle is still SPD, so PCG reaches the same tolerance: only iterations change.
+  const Scene scene = every_filter_case();
+  ch10::MultigridSettings lagged = three_levels();
+  lagged.coarse_refresh = 3;
+  ch10::MultigridStepper every_step(scene, test::tight_solver(), three_levels());
+  ch10::MultigridStepper every_third(scene, test::tight_solver(), lagged);
+  State a = rest_state(scene), b = rest_state(scene);
+  const Eigen::VectorXd X = a.x;
+  double motion = 0.0, difference = 0.0;
+  for (int k = 0; k < 20; ++k) {
+    every_step.step(a);
+    every_third.step(b);
+    CHECK(every_third.profile().converged);
+    motion = std::max(motion, (a.x - X).cwiseAbs().maxCoeff());
+    difference = std::max(difference, (a.x - b.x).cwiseAbs().maxCoeff());
+  }
+  INFO("max |dx| " << difference << " of motion " << motion);
+  CHECK(difference < 1e-8 * motion);
+  // The last step (the 20th) kept the coarse matrices of the 19th: still SPD.
+  std::srand(11);
+  const Eigen::Index n = X.size();
+  const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
+  Eigen::VectorXd Mx(n), My(n);
+  every_third.multigrid().apply(x, Mx);
+  every_third.multigrid().apply(y, My);
+  CHECK(std::abs(x.dot(My) - y.dot(Mx)) <= 1e-12 * std::sqrt(x.dot(Mx) * y.dot(My)));
+  CHECK(x.dot(Mx) > 0.0);
+}
