@@ -120,7 +120,7 @@ int run(const ArgParser& args) {
     iterations.push_back(p.cg_iterations);
     solve_ms.push_back(1e3 * p.solve.seconds);
     step_ms.push_back(1e3 * p.step.seconds);
-    if (steps >= 20 && (k + 1) % (steps / 4) == 0)
+    if ((k + 1) % std::max(1, steps / 4) == 0)
       std::cout << "  step " << k + 1 << "/" << steps << "\n" << std::flush;
   }
 
@@ -144,6 +144,8 @@ int run(const ArgParser& args) {
   std::cout << "  operator complexity (stored entries, all levels / finest): " << std::setprecision(2)
             << static_cast<double>(blocks) / fine_blocks << "\n";
 
+  std::cout << "measuring the last system: V-cycle, PCG with three preconditioners\n"
+            << std::flush;
   const int repeat = 20;
   Eigen::VectorXd x = Eigen::VectorXd::Ones(b.size()), y(b.size());
   const double spmv = time_ms(10 * repeat, [&] { A.multiply(x, y); });
