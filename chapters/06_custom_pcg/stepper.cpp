@@ -281,10 +281,12 @@ PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd&
     return result;
   }
   // Every product writes into q with noalias(): without it Eigen would evaluate the product
-  // into a temporary first, in case q appeared on the right. And A is symmetric, so A p =
-  // A^T p: the transpose of a column-major matrix is a row-major view, whose product is a
-  // dot product per row (a gather, each q_i written once) instead of chapter 05's scatter
-  // of each column into q (the README measures the difference).
+  // into a temporary first, in case q appeared on the right. A is symmetric, so A p = A^T p,
+  // and the transposed view is a row-major product: a gather, each q_i written once. That is
+  // what ConjugateGradient<M, Lower|Upper> does too (TransposeInput in ConjugateGradient.h).
+  // On one core it buys no speed: both of Eigen's kernels are scalar loops
+  // (sparse_time_dense_product_impl in SparseDenseProduct.h), and fem_lessons spmv measures
+  // the gather no faster than the scatter. Its gain is that rows can be split over threads.
   filter(constraints, y);
   q.noalias() = A.transpose() * y;
   r = b - q;
