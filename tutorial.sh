@@ -13,6 +13,8 @@ VENV="$ROOT/.venv"
 APT_PACKAGES=(
   build-essential cmake ninja-build git python3 python3-venv
   libeigen3-dev catch2
+  # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
+  libsuitesparse-dev
   # gmsh's runtime libraries (the PyPI wheel links against them)
   libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
   # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
@@ -142,6 +144,7 @@ docs() {
   log "lesson tables (fem_lessons)"
   "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   log "results tables and plots"
   "$VENV/bin/python" scripts/update_docs.py --images docs/images

@@ -104,7 +104,13 @@ def plot_solvers(data, out):
         return
     names = [s["name"] for s in solvers]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
-    ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
+    if all("setup_ms" in s and "solve_ms" in s for s in solvers):
+        setup = [s["setup_ms"] for s in solvers]
+        ax1.barh(names, setup, color="tab:orange", label="setup: compute() / factorize()")
+        ax1.barh(names, [s["solve_ms"] for s in solvers], left=setup, color="tab:blue",
+                 label="solve")
+    else:
+        ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
     poster = [POSTER_SOLVE_MS.get(n) for n in names]
     ys = [i for i, p in enumerate(poster) if p is not None]
     ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")

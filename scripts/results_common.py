@@ -92,6 +92,9 @@ def validate_bench(data):
         need(s, "name", str, where)
         for key in ("median_ms", "iterations", "allocations_per_solve"):
             need(s, key, float, where)
+        for key in ("setup_ms", "solve_ms"):  # absent in results written before they existed
+            if isinstance(s, dict) and key in s:
+                need(s, key, float, where)
     return problems
 
 

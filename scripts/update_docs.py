@@ -96,11 +96,12 @@ def solvers_table(data):
     rows = []
     for s in solvers:
         poster = POSTER_SOLVE_MS.get(s["name"])
-        rows.append([f"`{s['name']}`", ms(s["median_ms"]), ratio(base, s["median_ms"]),
+        split = [ms(s[k]) if k in s else "-" for k in ("setup_ms", "solve_ms")]
+        rows.append([f"`{s['name']}`", ms(s["median_ms"])] + split + [ratio(base, s["median_ms"]),
                      f"{s['iterations']:g}", f"{s['allocations_per_solve']:g}",
                      f"{poster:g} ms (x{POSTER_SOLVE_MS['eigen_cg'] / poster:.3g})" if poster else "-"])
-    return table(["solver", "median ms", f"vs `{solvers[0]['name']}`", "iterations",
-                  "allocations per solve", "poster"], rows)
+    return table(["solver", "median ms", "setup ms", "solve ms", f"vs `{solvers[0]['name']}`",
+                  "iterations", "allocations per solve", "poster"], rows)
 
 
 def scaling_table(scaling):
