@@ -35,10 +35,14 @@ commands:
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
+  regimes    build and run every chapter on both poster-sized bodies (the thin plate, the perforated
+             bar) over a sweep of Young's modulus, with the solve table at each point (about 10
+             minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
+             scripts/regimes.py (--help)
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
              the README and the chapter READMEs, plots copied to docs/images/), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
-             (docs/images/viewer.png, headless); run bench first (scaling and viewer-bench
+             (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
@@ -138,6 +142,12 @@ scaling() {
   "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
 }
 
+regimes() {
+  build
+  log "the regime sweep: every chapter, both poster-sized bodies, E over decades (scripts/regimes.py --help)"
+  "$VENV/bin/python" scripts/regimes.py --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
+}
+
 docs() {
   build
   [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
@@ -195,6 +205,7 @@ main() {
     test) run_tests "$@" ;;
     bench) bench "$@" ;;
     scaling) scaling "$@" ;;
+    regimes) regimes "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <string>
+#include <utility>
 
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
@@ -18,13 +19,13 @@ inline std::string mesh_path(const std::string& file) { return source_dir() + "/
 // The small committed test mesh: a 1 x 0.1 x 0.1 beam, at most 300 nodes.
 inline TetMesh test_mesh() { return load_mesh(mesh_path("test_beam.msh")); }
 
-// A scene on the test mesh with a material soft enough to move visibly in 50 steps.
-inline Scene test_scene(const std::string& name) {
+// A scene on the test mesh (or another) with a material soft enough to move visibly in 50 steps.
+inline Scene test_scene(const std::string& name, TetMesh mesh = test_mesh()) {
   Material m;
   m.youngs_modulus = 2e5;
   m.poisson_ratio = 0.3;
   m.density = 1000.0;
-  Scene s = make_scene(name, test_mesh(), m);
+  Scene s = make_scene(name, std::move(mesh), m);
   s.dt = 0.01;
   return s;
 }
