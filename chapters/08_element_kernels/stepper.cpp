@@ -101,33 +101,53 @@ constexpr int kMaxIterations = 12;
 
 }  // namespace
 
+namespace {
+
+// |q|^2 R(q / |q|), the rotation of a quaternion that need not be unit, without a division.
+Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
+  const double w = q.w(), x = q.x(), y = q.y(), z = q.z();
+  Eigen::Matrix3d R;
+  R << w * w + x * x - y * y - z * z, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),  //
+      2.0 * (x * y + w * z), w * w - x * x + y * y - z * z, 2.0 * (y * z - w * x),   //
+      2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z;
+  return R;
+}
+
+}  // namespace
+
 int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q) {
   const double scale2 = F.squaredNorm() / 3.0;
   if (!(F.determinant() > kMinRelativeDet * scale2 * std::sqrt(scale2))) return -1;  // or NaN
   // R = R_q exp([w]) makes R^T F symmetric: linearized, H w = axial(A - A^T) with
   // A = R_q^T F and H = tr(S) I - S, S = sym(A). H's eigenvalues are the sums of pairs of
   // S's, so H is positive definite exactly where S is (det S > 0): near the polar rotation.
+  // w does not change when A is scaled, so q need not be unit during the iteration: one
+  // normalization at the end instead of a square root and a division per iteration.
   for (int k = 1; k <= kMaxIterations; ++k) {
-    const Eigen::Matrix3d A = q.toRotationMatrix().transpose() * F;
+    const Eigen::Matrix3d A = scaled_rotation(q).transpose() * F;
     const Eigen::Vector3d axial(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1));
     Eigen::Matrix3d H = -0.5 * (A + A.transpose());
     H.diagonal().array() += A.trace();
     // Sylvester's criterion, and the adjugate solve of a symmetric 3x3: no pivoting, no LU.
     const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
     const double det = H.determinant();
-    if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > 1e-12 * scale2 * std::sqrt(scale2))) return -1;
+    const double q2 = q.squaredNorm();
+    if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2)))
+      return -1;
     Eigen::Matrix3d adjugate;
-    adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2),
-        H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
+    adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2), H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2),
+        H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
         H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 0) * H(2, 2) - H(0, 2) * H(0, 2),
         H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2),  //
         H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1), H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2), minor2;
     const Eigen::Vector3d w = adjugate * axial / det;
-    // exp([w]) to second order as the unit quaternion (1, w/2): a rotation, and Newton's
-    // quadratic convergence is kept. Renormalizing keeps q a rotation step after step.
+    // exp([w]) to second order as the quaternion (1, w/2): a rotation once normalized, and
+    // Newton's quadratic convergence is kept.
     q = q * Eigen::Quaterniond(1.0, 0.5 * w.x(), 0.5 * w.y(), 0.5 * w.z());
-    q.normalize();
-    if (w.squaredNorm() < kConvergedStep * kConvergedStep) return k;
+    if (w.squaredNorm() < kConvergedStep * kConvergedStep) {
+      q.normalize();
+      return k;
+    }
   }
   return -1;
 }
