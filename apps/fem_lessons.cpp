@@ -290,6 +290,8 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
   // How often the stepper falls back to the SVD on the benchmark's scenes.
   std::ostringstream scenes;
   for (const std::string& name : scene_names()) {
+    std::cerr << "fem_lessons rotations: " << steps << " steps of the " << name
+              << " scene, counting SVD fallbacks\n";
     Scene scene = make_scene(name, bench_scene.mesh, bench_scene.material);
     scene.dt = bench_scene.dt;
     ch08::ElementKernelsStepper run(scene, {});
