@@ -156,6 +156,7 @@ docs() {
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
   log "results tables and plots"
   "$VENV/bin/python" scripts/update_docs.py --images docs/images
   log "chapter diffs (docs/diffs/)"
