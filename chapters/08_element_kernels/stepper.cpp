@@ -394,7 +394,9 @@ PcgResult pcg_solve(const BlockSparseMatrix& A, const std::vector<int>& diagonal
       filter(constraints, r);
       ++result.iterations;
       residual_norm2 = r.squaredNorm();
-      if (residual_norm2 < threshold) break;
+      // A non-finite residual (an overflowed system) never recovers: stop at once and let
+      // divergence() report it, instead of running to the iteration cap on NaN.
+      if (residual_norm2 < threshold || !std::isfinite(residual_norm2)) break;
       precondition(inverse_diagonal, r, s);
       filter(constraints, s);
       const double rho_old = rho;
