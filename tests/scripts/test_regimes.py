@@ -85,7 +85,7 @@ def main():
         check("the solve table shows the softest and the stiffest point",
               f"E = {SOFT:g}" in solvers and f"E = {STIFF:g}" in solvers, solvers)
         repo = tmp / "repo"
-        (repo / "docs").mkdir(parents=True)
+        (repo / "docs").mkdir(parents=True, exist_ok=True)  # the build dir is reused between runs
         for f in ("README.md", "docs/results.md"):
             (repo / f).write_text((ROOT / f).read_text())
         update_docs.update_regimes(repo, out, repo / "docs" / "images")
