@@ -225,7 +225,12 @@ def regimes_solvers_table(reg):
         poster = POSTER_SOLVE_MS.get(n)
         rows.append([f"`{n}`"] + cells + [f"{poster:g} ms" if poster else "-"])
     header = [f"`{p['body']}`, E = {p['E']:g} (01: {regimes_common.iterations(p):g} it.)" for p in shown]
-    return table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows)
+    ends = "; ".join(
+        f"`{body}`: x{regimes_common.solver_ratio(pts[0], 'pcg_ch06'):.2f} at the softest point, "
+        f"x{regimes_common.solver_ratio(pts[-1], 'pcg_ch06'):.2f} at the stiffest"
+        for body, pts in ((b, regimes_common.body_points(reg, b)) for b in reg["bodies"]))
+    return (table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows) +
+            f"\nOur PCG over Eigen's `solve()` (poster x4.226): {ends}.\n")
 
 
 def update_regimes(root, path, images):
