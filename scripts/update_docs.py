@@ -302,8 +302,13 @@ def main():
                         help="default: ROOT/results/regimes.json, else ROOT/docs/data/regimes.json")
     parser.add_argument("--images", type=pathlib.Path, nargs="?", const=pathlib.Path("docs/images"),
                         help="copy the PNG plots from the results directory here (default docs/images)")
+    parser.add_argument("--only-regimes", action="store_true",
+                        help="only the regime sweep's sections (no results/bench.json needed)")
     args = parser.parse_args()
     root = args.root
+    if args.only_regimes:
+        update_regimes(root, args.regimes, args.images)
+        return
     bench_path = args.bench or root / "results" / "bench.json"
     scaling_path = args.scaling or root / "results" / "scaling.json"
     try:
