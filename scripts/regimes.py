@@ -28,9 +28,10 @@ from results_common import BASELINE, PHASE_LABELS, ResultsError, die, footer, lo
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BODIES = ["meshes/plate_poster.msh", "meshes/perforated_bar_poster.msh"]
-# Five decades in half-decade steps (1, 3, 10, ...): from a soft body that chapter 01's CG solves in a
-# handful of iterations to a stiff one that takes it hundreds.
-E_VALUES = [1e3, 3e3, 1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8]
+# Half-decade steps (1, 3, 10, ...) over four and a half decades: from a soft body that chapter 01's
+# CG solves in a handful of iterations to a stiff one that takes it hundreds (beyond, the stiff
+# plate's points cost most of the sweep's time and add no new regime).
+E_VALUES = [1e3, 3e3, 1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7]
 
 
 def numbers(text):
@@ -202,8 +203,8 @@ def main():
                         help=f"Young's moduli in Pa, comma-separated (default {','.join(f'{e:g}' for e in E_VALUES)})")
     parser.add_argument("--scene", default="cantilever")
     parser.add_argument("--chapters", default="all", help="passed to fem_bench (default all: the registry)")
-    parser.add_argument("--steps", type=int, default=20, help="measured steps per point (default 20)")
-    parser.add_argument("--warmup", type=int, default=3, help="unmeasured steps first (default 3)")
+    parser.add_argument("--steps", type=int, default=16, help="measured steps per point (default 16)")
+    parser.add_argument("--warmup", type=int, default=2, help="unmeasured steps first (default 2)")
     parser.add_argument("--no-solvers", action="store_true", help="skip the solve table")
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "results" / "regimes.json")
     parser.add_argument("--plot", type=pathlib.Path, help="the PNG (default: regimes.png beside --out)")

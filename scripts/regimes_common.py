@@ -146,8 +146,9 @@ def describe(points, target, measure):
     if all(reached[:last + 1]):
         return (f"**up to {where(points[last])}** (x{values[last][0]:.3g} there); "
                 f"above, at most x{max(v for v, _ in values[last + 1:]):.3g}")
-    hits = ", ".join(where(points[i]) for i, r in enumerate(reached) if r)
-    return f"**only at {hits}**"
+    lo, hi = min(v for v, _ in values), max(v for v, _ in values)
+    return (f"at {sum(reached)} of {len(points)} points, not ordered by the regime "
+            f"(x{lo:.3g} to x{hi:.3g})")
 
 
 def first_reached(data, key, target):
@@ -196,6 +197,8 @@ def poster_statements(data):
     lines += ["| " + " | ".join([number, who] + cells) + " |" for number, who, cells in poster_rows(data)]
     target = next(t for k, _, t in POSTER_NUMBERS if k == "step")
     hit = first_reached(data, "step", target)
+    forces = sorted((share(p, "forces"), p) for p in data["points"])
+    (low, p_low), (high, p_high) = forces[0], forces[-1]
     e = data["E_values"]
     lines += ["", (f"The overall step first reaches x{target:g} at {hit[0]:g} iterations of chapter "
                    f"01's CG (`{hit[1]}`, chapter `{hit[2]}`, x{hit[3]:.3g})." if hit else
@@ -203,5 +206,10 @@ def poster_statements(data):
               f" Sweep: E from {min(e):g} to {max(e):g} Pa at dt = {data['dt']:g} s, {data['scene']}, "
               f"{data['steps']} measured steps per point, CG tolerance {data['cg_tolerance']:g}; "
               f"x{target:g} and the rest are medians' ratios over chapter 01 (\"it.\": chapter 01's "
-              "median CG iterations; \"solve\": the solve's share of chapter 01's median step)."]
+              "median CG iterations; \"solve\": the solve's share of chapter 01's median step).",
+              "", f"Amdahl's bound: chapter 01's forces phase (rotations and element forces) takes from "
+              f"{100 * low:.0f}% (`{p_low['body']}`, {where(p_low)}) to {100 * high:.0f}% (`{p_high['body']}`, "
+              f"{where(p_high)}) of its step, so a chapter that leaves that phase as it is cannot make the "
+              f"step more than x{1 / high:.3g} faster where it weighs most (x{1 / low:.3g} where it weighs "
+              f"least), however fast the rest; x{target:g} needs it under {100 / target:.1f}%."]
     return "\n".join(lines) + "\n"

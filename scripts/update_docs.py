@@ -233,7 +233,12 @@ def regimes_solvers_table(reg):
         poster = POSTER_SOLVE_MS.get(n)
         rows.append([f"`{n}`"] + cells + [f"{poster:g} ms" if poster else "-"])
     header = [f"`{p['body']}`, E = {p['E']:g} (01: {regimes_common.iterations(p):g} it.)" for p in shown]
-    return table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows)
+    ends = "; ".join(
+        f"`{body}`: x{regimes_common.solver_ratio(pts[0], 'pcg_ch06'):.2f} at the softest point, "
+        f"x{regimes_common.solver_ratio(pts[-1], 'pcg_ch06'):.2f} at the stiffest"
+        for body, pts in ((b, regimes_common.body_points(reg, b)) for b in reg["bodies"]))
+    return (table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows) +
+            f"\nOur PCG over Eigen's `solve()` (poster x4.226): {ends}.\n")
 
 
 def update_regimes(root, path, images):
@@ -305,8 +310,13 @@ def main():
                         help="default: ROOT/results/regimes.json, else ROOT/docs/data/regimes.json")
     parser.add_argument("--images", type=pathlib.Path, nargs="?", const=pathlib.Path("docs/images"),
                         help="copy the PNG plots from the results directory here (default docs/images)")
+    parser.add_argument("--only-regimes", action="store_true",
+                        help="only the regime sweep's sections (no results/bench.json needed)")
     args = parser.parse_args()
     root = args.root
+    if args.only_regimes:
+        update_regimes(root, args.regimes, args.images)
+        return
     bench_path = args.bench or root / "results" / "bench.json"
     scaling_path = args.scaling or root / "results" / "scaling.json"
     try:

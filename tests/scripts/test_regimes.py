@@ -10,6 +10,7 @@ Prints 'N passed, M failed' last; exits 1 if any check failed."""
 import copy
 import json
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -85,7 +86,8 @@ def main():
         check("the solve table shows the softest and the stiffest point",
               f"E = {SOFT:g}" in solvers and f"E = {STIFF:g}" in solvers, solvers)
         repo = tmp / "repo"
-        (repo / "docs").mkdir(parents=True, exist_ok=True)  # the build dir is reused between runs
+        shutil.rmtree(repo, ignore_errors=True)  # a previous run's copy, in a kept work directory
+        (repo / "docs").mkdir(parents=True)
         for f in ("README.md", "docs/results.md"):
             (repo / f).write_text((ROOT / f).read_text())
         update_docs.update_regimes(repo, out, repo / "docs" / "images")
