@@ -7,10 +7,7 @@
 
 using namespace fem;
 
-TEST_CASE("ch04: matches chapter 01 on both scenes over 50 steps", "[ch04]") {
-  for (const char* name : {"cantilever", "sliding"})
-    test::check_matches_ch01("04", test::test_scene(name));
-}
+FEM_CHAPTER_TESTS("04", "[ch04]")
 
 TEST_CASE("ch04: the composed system equals chapter 03's sparse expression", "[ch04]") {
   const Scene scene = test::test_scene("sliding");

@@ -45,10 +45,7 @@ TEST_CASE("ch07: the filtered block system equals chapter 05's", "[ch07]") {
   }
 }
 
-TEST_CASE("ch07: matches chapter 01 on both scenes over 50 steps", "[ch07]") {
-  for (const char* name : {"cantilever", "sliding"})
-    test::check_matches_ch01("07", test::test_scene(name));
-}
+FEM_CHAPTER_TESTS("07", "[ch07]")
 
 TEST_CASE("ch07: zero heap allocations per step after the first", "[ch07][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();
