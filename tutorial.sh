@@ -35,8 +35,9 @@ commands:
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
-  docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
-             the README and the chapter READMEs, plots copied to docs/images/), the lesson
+  docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
+             of the docs from it (tables in docs/results.md, the README and the chapter
+             READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling and viewer-bench
              too, for their tables: without their results the committed tables stay)
@@ -146,8 +147,16 @@ docs() {
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
-  log "results tables and plots"
-  "$VENV/bin/python" scripts/update_docs.py --images docs/images
+  log "results: the run's JSON committed under docs/data/, tables and plots from it"
+  mkdir -p docs/data
+  for json in bench scaling viewer; do
+    if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
+  done
+  "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
+  if [ -f docs/data/scaling.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+  fi
+  "$VENV/bin/python" scripts/update_docs.py
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then

@@ -286,7 +286,7 @@ PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd&
   // what ConjugateGradient<M, Lower|Upper> does too (TransposeInput in ConjugateGradient.h).
   // On one core it buys no speed: both of Eigen's kernels are scalar loops
   // (sparse_time_dense_product_impl in SparseDenseProduct.h), and fem_lessons spmv measures
-  // the gather no faster than the scatter. Its gain is that rows can be split over threads.
+  // them within a few percent of each other. Its gain is that rows can be split over threads.
   filter(constraints, y);
   q.noalias() = A.transpose() * y;
   r = b - q;
