@@ -142,6 +142,23 @@ def main():
         p = run(SCRIPTS / "validate_bench.py", bad)
         check("validate_bench.py exits 1 on a broken file", p.returncode == 1, p.stdout + p.stderr)
 
+        # The chapter drift check: a chapter copied forward and not renamed is caught.
+        drift = tmp / "drift"
+        (drift / "chapters" / "08_copied").mkdir(parents=True)
+        (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
+            '// Chapter 07: one linearized backward Euler step\n#include <iostream>\n'
+            'void f() { throw 1 ? "07_block_sparse: a table does not match" : ""; }\n')
+        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
+        check("check_chapter_sources.py catches a header, a string and an unused <iostream>",
+              p.returncode == 1 and "'Chapter 07'" in p.stderr and "names chapter 07" in p.stderr
+              and "<iostream>" in p.stderr, p.stderr)
+        (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
+            '// Chapter 08: one step, as chapter 07 wrote it\n#include "chapters/07_x/stepper.hpp"\n'
+            'void f() { throw "08_copied: a table does not match"; }\n')
+        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
+        check("check_chapter_sources.py accepts a chapter that names only itself",
+              p.returncode == 0, p.stdout + p.stderr)
+
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0
 
