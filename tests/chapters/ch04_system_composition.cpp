@@ -10,7 +10,7 @@ using namespace fem;
 FEM_CHAPTER_TESTS("04", "[ch04]")
 
 TEST_CASE("ch04: the composed system equals chapter 03's sparse expression", "[ch04]") {
-  const Scene scene = test::test_scene("sliding");
+  const Scene scene = test::driven_scene();
   ch03::IndexedAccessStepper expression(scene, test::tight_solver());
   ch04::SystemCompositionStepper one_pass(scene, test::tight_solver());
   State state = rest_state(scene);
