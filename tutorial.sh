@@ -39,8 +39,9 @@ commands:
              bar) over a sweep of Young's modulus, with the solve table at each point (about 10
              minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
              scripts/regimes.py (--help)
-  docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
-             the README and the chapter READMEs, plots copied to docs/images/), the lesson
+  docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
+             of the docs from it (tables in docs/results.md, the README and the chapter
+             READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
@@ -157,8 +158,17 @@ docs() {
   "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
-  log "results tables and plots"
-  "$VENV/bin/python" scripts/update_docs.py --images docs/images
+  log "results: the run's JSON committed under docs/data/, tables and plots from it"
+  mkdir -p docs/data
+  for json in bench scaling viewer regimes; do
+    if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
+  done
+  "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
+  if [ -f docs/data/scaling.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+  fi
+  if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
+  "$VENV/bin/python" scripts/update_docs.py
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then

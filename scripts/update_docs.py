@@ -10,8 +10,14 @@ comments (never typed by hand):
                            docs/data/regimes.json; without it, from docs/data/regimes.json)
   chapters/NN_*/README.md  bench-table:<chapter>, and results:solvers where present
 
-    .venv/bin/python scripts/update_docs.py                  # from results/bench.json
+The JSON behind the committed docs is committed too, in docs/data/ (bench.json, and
+scaling.json and viewer.json when they were run): `./tutorial.sh docs` copies a new run there
+first. --check writes nothing and fails when a generated section differs from what the
+committed JSON gives (ctest label docs).
+
+    .venv/bin/python scripts/update_docs.py                  # from docs/data/bench.json
     .venv/bin/python scripts/update_docs.py --images docs/images   # also copy the plots
+    .venv/bin/python scripts/update_docs.py --check          # are the docs those of docs/data?
 """
 import argparse
 import pathlib
@@ -187,8 +193,8 @@ def chapter_table(data, name):
     shown = [x for i, x in enumerate(shown) if x not in shown[:i]]
     rows = [[f"`{x['chapter']}`"] + [ms(x["median_ms"][p]) for p in ALL_PHASES] +
             [f"{x['allocations_per_step']:g}", f"{x['cg_iterations']:g}"] for x in shown]
-    for ref in (by.get(BASELINE), previous):
-        if ref is not None and ref is not c:
+    refs = [r for r in (by.get(BASELINE), previous) if r is not None and r is not c]
+    for ref in [r for i, r in enumerate(refs) if r not in refs[:i]]:  # 02: previous is 01
             rows.append([f"speedup over `{ref['chapter']}`"] +
                         [ratio(ref["median_ms"][p], c["median_ms"][p]) for p in ALL_PHASES] + ["", ""])
     header = ["median ms"] + [PHASE_LABELS[p] for p in ALL_PHASES] + ["allocations/step", "CG it."]
@@ -241,7 +247,7 @@ def regimes_solvers_table(reg):
             f"\nOur PCG over Eigen's `solve()` (poster x4.226): {ends}.\n")
 
 
-def update_regimes(root, path, images):
+def update_regimes(root, path, images, stale=None):
     """The regime sweep's generated sections (results/regimes.json, kept as docs/data/regimes.json,
     the JSON behind the committed docs): without a sweep, the committed sections stay."""
     data_copy = root / "docs" / "data" / "regimes.json"
@@ -258,15 +264,18 @@ def update_regimes(root, path, images):
     problems = regimes_common.validate_regimes(reg)
     if problems:
         die(f"update_docs.py: {source} does not match the regimes schema:\n  " + "\n  ".join(problems))
-    if source.resolve() != data_copy.resolve():
+    if source.resolve() != data_copy.resolve() and stale is None:
         data_copy.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(source, data_copy)
         print(f"copied {source.name} to {data_copy.parent}")
     poster = regimes_common.poster_statements(reg)
     update_file(root / "docs" / "results.md", {"regimes:poster": poster,
                                                "regimes:points": regimes_points_table(reg),
-                                               "regimes:solvers": regimes_solvers_table(reg)})
-    update_file(root / "README.md", {"regimes:poster": poster})
+                                               "regimes:solvers": regimes_solvers_table(reg)},
+                stale)
+    update_file(root / "README.md", {"regimes:poster": poster}, stale)
+    if stale is not None:
+        return
     png = source.with_name("regimes.png")
     if images and png.exists() and source != data_copy:
         images = images if images.is_absolute() else root / images
@@ -284,17 +293,25 @@ def replace(text, name, body):
     return pattern.sub(lambda _: begin + "\n" + body + end, text), True
 
 
-def update_file(path, sections):
+def update_file(path, sections, stale=None):
+    """Writes the sections into path; with a list `stale`, writes nothing and appends to it
+    the sections whose committed text differs."""
     if not path.exists():
         print(f"note: {path} is missing, skipped")
         return
-    text = path.read_text()
+    original = text = path.read_text()
     done = []
     for name, body in sections.items():
+        before = text
         text, found = replace(text, name, body)
         if found:
             done.append(name)
-    path.write_text(text)
+            if stale is not None and text != before:
+                stale.append(f"{path}: {name}")
+    if stale is not None:
+        return
+    if text != original:
+        path.write_text(text)
     if done:
         print(f"updated {path}: {', '.join(done)}")
 
@@ -303,11 +320,13 @@ def main():
     root_default = pathlib.Path(__file__).resolve().parent.parent
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--root", type=pathlib.Path, default=root_default, help="repository root")
-    parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/results/bench.json")
-    parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/results/scaling.json if present")
-    parser.add_argument("--viewer", type=pathlib.Path, help="default: ROOT/results/viewer.json if present")
+    parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/docs/data/bench.json")
+    parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/docs/data/scaling.json if present")
+    parser.add_argument("--viewer", type=pathlib.Path, help="default: ROOT/docs/data/viewer.json if present")
     parser.add_argument("--regimes", type=pathlib.Path,
                         help="default: ROOT/results/regimes.json, else ROOT/docs/data/regimes.json")
+    parser.add_argument("--check", action="store_true",
+                        help="write nothing; exit 1 if a generated section differs from the JSON")
     parser.add_argument("--images", type=pathlib.Path, nargs="?", const=pathlib.Path("docs/images"),
                         help="copy the PNG plots from the results directory here (default docs/images)")
     parser.add_argument("--only-regimes", action="store_true",
@@ -317,12 +336,13 @@ def main():
     if args.only_regimes:
         update_regimes(root, args.regimes, args.images)
         return
-    bench_path = args.bench or root / "results" / "bench.json"
-    scaling_path = args.scaling or root / "results" / "scaling.json"
+    data_dir = root / "docs" / "data"
+    bench_path = args.bench or data_dir / "bench.json"
+    scaling_path = args.scaling or data_dir / "scaling.json"
     try:
         data = load_checked(bench_path)
         scaling = load_checked(scaling_path, scaling=True) if scaling_path.exists() else None
-        viewer_path = args.viewer or root / "results" / "viewer.json"
+        viewer_path = args.viewer or data_dir / "viewer.json"
         viewer = load_checked(viewer_path, viewer=True) if viewer_path.exists() else None
     except ResultsError as e:
         die(f"update_docs.py: {e}")
@@ -336,17 +356,29 @@ def main():
     # committed table stays as it is (a placeholder goes in only where there is no table yet).
     if scaling is not None or "run `./tutorial.sh scaling`" in (root / "docs" / "results.md").read_text():
         tables["results:scaling"] = scaling_table(scaling)
-    else:
-        print("no results/scaling.json: the scaling table in docs/results.md is left as it is")
-    update_file(root / "docs" / "results.md", tables)
+    elif not args.check:
+        print(f"no {scaling_path}: the scaling table in docs/results.md is left as it is")
+    stale = [] if args.check else None
+    update_file(root / "docs" / "results.md", tables, stale)
     readme = {"headline": headline(data), "chapter-map": chapter_map(data)}
     if viewer is not None:  # like the scaling table: optional, kept as it is without a new run
         readme["viewer-fps"] = viewer_table(viewer)
-    update_file(root / "README.md", readme)
+    update_file(root / "README.md", readme, stale)
     for c in data["chapters"]:
         update_file(root / "chapters" / c["chapter"] / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),
-                     "results:solvers": solvers})
+                     "results:solvers": solvers}, stale)
+    if args.check:
+        # The regime sections are checked against the committed sweep only.
+        update_regimes(root, args.regimes or data_dir / "regimes.json", None, stale)
+        for s in stale:
+            print(f"stale: {s} differs from what {bench_path} gives", file=sys.stderr)
+        if stale:
+            print("update_docs.py --check: regenerate with `.venv/bin/python scripts/update_docs.py`",
+                  file=sys.stderr)
+            sys.exit(1)
+        print(f"update_docs.py --check: every generated section matches {bench_path}")
+        return
     if args.images:
         images = args.images if args.images.is_absolute() else root / args.images
         images.mkdir(parents=True, exist_ok=True)

@@ -57,7 +57,8 @@ class IndexedAccessStepper final : public Stepper {
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;  // (h + beta) v, then b - A z
+  Eigen::VectorXd scaled_v_;        // (h + beta) v, the vector df/dx multiplies in b
+  Eigen::VectorXd unfiltered_rhs_;  // b - A z, before the product with S
   std::vector<Eigen::Triplet<double>> s_triplets_;
   std::vector<bool> constrained_;
   Eigen::SparseMatrix<double> identity_;

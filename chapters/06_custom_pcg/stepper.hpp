@@ -87,7 +87,7 @@ class CustomPcgStepper final : public Stepper {
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;  // (h + beta) v
+  Eigen::VectorXd scaled_v_;  // (h + beta) v, the vector df/dx multiplies in b
 
   // The block structure of the pattern, built once. Column block j (the columns of node j)
   // holds one 3x3 block per neighbour i, in order; block k starts at row 3 * (its k-th

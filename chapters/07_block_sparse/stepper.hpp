@@ -94,7 +94,7 @@ class BlockSparseStepper final : public Stepper {
   Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;        // S (b - A z)
   Eigen::VectorXd dv_;
-  Eigen::VectorXd tmp_;  // (h + beta) v
+  Eigen::VectorXd scaled_v_;  // (h + beta) v, the vector df/dx multiplies in b
   PcgWorkspace pcg_;
   Eigen::VectorXd y_;  // the unknown of the filtered system, dv = y + z: also the warm start
 };
