@@ -221,8 +221,8 @@ void ElementKernelsStepper::step(State& state) {
     start_system(state);
   }
   {
-    // The fused pass: rotations, forces and the blocks of df/dx, written into A and b.
-    // It does the work of the forces, df/dx and composition phases of chapter 07 and is
+    // The fused pass: rotations, forces and the blocks of df/dx, written into A and b. It
+    // does the work of the earlier chapters' forces, df/dx and composition phases and is
     // reported under forces; dfdx stays zero, because no df/dx is built.
     PhaseTimer t(profile_.forces);
     element_pass(state);

@@ -34,7 +34,7 @@ ElementShape make_element_shape(const ElementRest& rest, const Lame& lame);
 // convergence within the iteration cap. q is unusable after -1.
 int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q);
 
-// The rotation common/'s polar_rotation returns (to about 1e-13, see the tests), by Newton
+// The rotation common/'s polar_rotation returns (to 1e-12 per entry, the tests), by Newton
 // from q where it decides, and by common/'s SVD where it does not (then ++fallbacks). q
 // holds the answer on exit, the next step's warm start.
 Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
