@@ -30,8 +30,13 @@ commands:
   setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
   build      set up if needed and build (preset: \$PRESET, default release)
   test       build and run every test through ctest (ctest arguments may follow, e.g. -L ch01)
-  bench      build and benchmark every chapter on the poster-sized mesh:
-             prints the per-phase table, writes results/bench.json (and plots when present)
+  bench      build (quietly) and benchmark every chapter on the poster-sized mesh: prints the
+             per-phase table; a run is a folder, --out DIR (default results) gets bench.json
+             and the plots made from it; other arguments go to fem_bench (--chapters 06,07,
+             --mesh, --scene, --steps; fem_bench --help)
+  plots      remake the plots of a run folder from its bench.json: ./tutorial.sh plots DIR
+  variant    copy a chapter under a new name to change it and measure it against the
+             original: ./tutorial.sh variant 06 my_fused_updates (chapters/README.md)
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
@@ -119,21 +124,59 @@ build() {
   cmake --build --preset "$PRESET"
 }
 
+# The build with its log kept out of the way of the results that follow: a summary line, the
+# log's tail on failure, and the warnings (if any) named.
+quiet_build() {
+  setup
+  local build_log="$BUILD_DIR/build.log"
+  log "building (preset $PRESET; log in ${build_log#"$ROOT"/})"
+  if ! cmake --build --preset "$PRESET" >"$build_log" 2>&1; then
+    tail -n 40 "$build_log" >&2
+    echo "the build failed: the whole log is $build_log" >&2
+    exit 1
+  fi
+  local warnings
+  warnings=$(grep -c "warning:" "$build_log" || true)
+  [ "$warnings" -eq 0 ] || echo "the build printed $warnings warnings: see $build_log" >&2
+}
+
 run_tests() {
   build
   log "running the tests"
   ctest --preset "$PRESET" -j "$(nproc)" "$@"
 }
 
+# A run is a folder: fem_bench writes DIR/bench.json and the plots are made from that file,
+# so plots and numbers always belong together.
 bench() {
-  build
-  mkdir -p results
-  log "benchmarking every chapter on the poster-sized mesh"
-  "$BUILD_DIR/fem_bench" --json results/bench.json "$@"
-  if [ -f scripts/plot_results.py ]; then
-    log "plotting"
-    "$VENV/bin/python" scripts/plot_results.py results/bench.json --out results
-  fi
+  local out=results json="" args=("$@") i  # fem_bench's defaults
+  for ((i = 0; i < ${#args[@]}; i++)); do
+    case "${args[i]}" in
+      --out) out="${args[i + 1]:-}" ;;
+      --json) json="${args[i + 1]:-}" ;;
+    esac
+  done
+  [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; }
+  [ -n "$json" ] || json="$out/bench.json"
+  quiet_build
+  log "benchmarking: fem_bench $* (the run's folder: $out/)"
+  "$BUILD_DIR/fem_bench" "$@"
+  plots "$json" "$out"
+}
+
+# Plots of one run from its JSON: ./tutorial.sh plots DIR (or a bench.json and a folder).
+plots() {
+  local json="${1:-results}" out="${2:-}"
+  [ -d "$json" ] && { out="${out:-$json}"; json="$json/bench.json"; }
+  out="${out:-$(dirname "$json")}"
+  log "plotting $json into $out/"
+  "$VENV/bin/python" scripts/plot_results.py "$json" --out "$out"
+}
+
+variant() {
+  [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
+  setup_venv
+  "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
 scaling() {
@@ -215,6 +258,8 @@ main() {
     build) build ;;
     test) run_tests "$@" ;;
     bench) bench "$@" ;;
+    plots) plots "$@" ;;
+    variant) variant "$@" ;;
     scaling) scaling "$@" ;;
     regimes) regimes "$@" ;;
     docs) docs ;;

@@ -55,6 +55,7 @@ Spread spread(std::vector<double> v) {
 struct ChapterResult {
   std::string chapter;
   std::string title;
+  std::string variant_of;                      // a student's variant: its original
   std::array<Spread, 6> ms;                    // per phase, milliseconds
   double allocations_per_step;                 // median over the measured steps
   std::array<long long, 6> phase_allocations;  // per phase, the last measured step
@@ -88,7 +89,7 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                     {},
                     {},
                     {},
-                    ChapterResult{c->id, c->title, {}, 0.0, {}, 0, 0.0, 0.0, 0}});
+                    ChapterResult{c->id, c->title, c->variant_of, {}, 0.0, {}, 0, 0.0, 0.0, 0}});
   const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
     for (ChapterRun& run : runs) {
@@ -331,7 +332,7 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
   for (std::size_t i = 0; i < results.size(); ++i) {
     const ChapterResult& r = results[i];
     out << "    {\"chapter\": " << json_string(r.chapter) << ", \"title\": " << json_string(r.title)
-        << ",\n"
+        << (r.variant_of.empty() ? "" : ", \"variant_of\": " + json_string(r.variant_of)) << ",\n"
         << "     \"median_ms\": " << spread_json(r.ms, &Spread::median) << ",\n"
         << "     \"min_ms\": " << spread_json(r.ms, &Spread::min) << ",\n"
         << "     \"q1_ms\": " << spread_json(r.ms, &Spread::q1) << ",\n"
@@ -413,18 +414,27 @@ std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
   return out;
 }
 
+// --json FILE, else DIR/bench.json of --out DIR; "" when both are empty.
+std::string json_path(const ArgParser& args) {
+  if (!args.get("json").empty()) return args.get("json");
+  if (args.get("out").empty()) return "";
+  return (std::filesystem::path(args.get("out")) / "bench.json").string();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   ArgParser args("fem_bench",
                  "Benchmarks chapters on one scene: per-phase median ms, allocations per step,\n"
-                 "CG iterations; prints a table and writes JSON (schema in README.md).");
+                 "CG iterations; prints a table and writes JSON (schema in README.md) into the\n"
+                 "run's folder (--out), where ./tutorial.sh bench also writes the plots.");
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
   args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
   args.option("warmup", "N", "unmeasured steps first, >= 0", "10");
-  args.option("json", "FILE", "where to write the results ('' for nowhere)", "results/bench.json");
+  args.option("out", "DIR", "the run's folder: writes DIR/bench.json ('' for nowhere)", "results");
+  args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
   args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
   try {
     if (!args.parse(argc, argv)) return 0;
@@ -453,9 +463,11 @@ int main(int argc, char** argv) {
       std::cout << " done\n";
       print_solvers(solvers);
     }
-    if (const std::string& path = args.get("json"); !path.empty()) {
+    if (const std::string path = json_path(args); !path.empty()) {
+      const bool replaced = std::filesystem::exists(path);
       write_json(path, scene, solver, warmup, steps, results, solvers);
-      std::cout << "\nwrote " << path << "\n";
+      std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there)" : "")
+                << "\n";
     }
   } catch (const UsageError& e) {
     std::cerr << "fem_bench: " << e.what() << " (see fem_bench --help)\n";
