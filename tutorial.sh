@@ -13,6 +13,8 @@ VENV="$ROOT/.venv"
 APT_PACKAGES=(
   build-essential cmake ninja-build git python3 python3-venv
   libeigen3-dev catch2
+  # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
+  libsuitesparse-dev
   # gmsh's runtime libraries (the PyPI wheel links against them)
   libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
   # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
@@ -38,10 +40,15 @@ commands:
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
-  docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
-             the README and the chapter READMEs, plots copied to docs/images/), the lesson
+  regimes    build and run every chapter on both poster-sized bodies (the thin plate, the perforated
+             bar) over a sweep of Young's modulus, with the solve table at each point (about 10
+             minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
+             scripts/regimes.py (--help)
+  docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
+             of the docs from it (tables in docs/results.md, the README and the chapter
+             READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
-             (docs/images/viewer.png, headless); run bench first (scaling and viewer-bench
+             (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
@@ -179,15 +186,32 @@ scaling() {
   "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
 }
 
+regimes() {
+  build
+  log "the regime sweep: every chapter, both poster-sized bodies, E over decades (scripts/regimes.py --help)"
+  "$VENV/bin/python" scripts/regimes.py --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
+}
+
 docs() {
   quiet_build
   [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
   log "lesson tables (fem_lessons)"
   "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
-  log "results tables and plots"
-  "$VENV/bin/python" scripts/update_docs.py --images docs/images
+  "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
+  log "results: the run's JSON committed under docs/data/, tables and plots from it"
+  mkdir -p docs/data
+  for json in bench scaling viewer regimes; do
+    if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
+  done
+  "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
+  if [ -f docs/data/scaling.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+  fi
+  if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
+  "$VENV/bin/python" scripts/update_docs.py
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then
@@ -237,6 +261,7 @@ main() {
     plots) plots "$@" ;;
     variant) variant "$@" ;;
     scaling) scaling "$@" ;;
+    regimes) regimes "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;

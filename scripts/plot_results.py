@@ -70,20 +70,25 @@ def plot_speedup(data, out):
         finish(fig, data, out / "speedup.png")
         return
     others = [c for c in chapters if c is not base]
+    # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
+    phases = ["forces"] + PHASES
     poster = comparable_to_poster(data)
     bars = len(others) + (1 if poster else 0)
-    x = np.arange(len(PHASES))
+    x = np.arange(len(phases))
     width = 0.8 / bars
     for i, c in enumerate(others):
-        s = [base["median_ms"][p] / max(c["median_ms"][p], 1e-9) for p in PHASES]
+        # A phase a chapter no longer has (chapter 08's df/dx, fused into its element pass) gets
+        # no bar rather than an infinite one.
+        s = [base["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
+             for p in phases]
         ax.bar(x + (i - (bars - 1) / 2) * width, s, width, label=c["chapter"], color=color(c))
     if poster:
         ax.bar(x + (len(others) - (bars - 1) / 2) * width,
-               [POSTER_SPEEDUPS.get(p, np.nan) for p in PHASES], width, color="none",
+               [POSTER_SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
                edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
-    ax.set_xticks(x, [PHASE_LABELS[p] for p in PHASES])
+    ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
     ax.set_title("Speedup per phase over the naive stepper" + (", beside the poster's" if poster else "")
                  + f" ({run_label(data)})")
@@ -115,12 +120,18 @@ def plot_solvers(data, out):
         return
     names = [s["name"] for s in solvers]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
-    ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
+    if all("setup_ms" in s and "solve_ms" in s for s in solvers):
+        setup = [s["setup_ms"] for s in solvers]
+        ax1.barh(names, setup, color="tab:orange", label="setup: compute() / factorize()")
+        ax1.barh(names, [s["solve_ms"] for s in solvers], left=setup, color="tab:blue",
+                 label="solve")
+    else:
+        ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
     if comparable_to_poster(data):  # absolute times compare only on the poster's run
         poster = [POSTER_SOLVE_MS.get(n) for n in names]
         ys = [i for i, p in enumerate(poster) if p is not None]
         ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
-        ax1.legend(fontsize=8)
+    ax1.legend(fontsize=8)
     ax1.invert_yaxis()
     ax1.set_xlabel("median time per solve [ms]")
     ax1.set_title("Time per solve")
