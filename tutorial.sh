@@ -180,7 +180,7 @@ variant() {
 }
 
 scaling() {
-  build
+  quiet_build
   log "scaling over the beam series (a time budget per run; --help for the options)"
   "$VENV/bin/python" scripts/scaling.py --bench "$BUILD_DIR/fem_bench" --out results/scaling.json "$@"
   "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
@@ -193,7 +193,7 @@ regimes() {
 }
 
 docs() {
-  build
+  quiet_build
   [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
   log "lesson tables (fem_lessons)"
   "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
@@ -222,7 +222,7 @@ docs() {
 }
 
 sim() {
-  build
+  quiet_build
   log "simulating the cantilever on the poster-sized mesh (VTK frames in out/sim/)"
   "$BUILD_DIR/fem_sim" --out out/sim --every 4 "$@"
   log "rendering the frames to docs/images/cantilever.gif"
@@ -232,14 +232,14 @@ sim() {
 }
 
 viewer() {
-  build
+  quiet_build
   [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
   log "opening the viewer (space: pause, s: step, r: reset; drag the body with the mouse)"
   "$BUILD_DIR/fem_viewer" "$@"
 }
 
 viewer_bench() {
-  build
+  quiet_build
   [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
   log "the viewer's frame rate per chapter, headless (Xvfb, Mesa's software OpenGL)"
   "$VENV/bin/python" scripts/viewer_fps.py --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"

@@ -71,6 +71,10 @@ def main():
             check(f"make_variant.py {' '.join(bad)} is refused ({reason})",
                   p.returncode == 2 and reason in p.stderr, p.stderr)
 
+        p = run(ROOT / "tutorial.sh", "variant", "06")
+        check("./tutorial.sh variant without a name prints its usage and exits 2",
+              p.returncode == 2 and "usage: ./tutorial.sh variant NN NAME" in p.stderr, p.stderr)
+
         # The registry the build would generate.
         generated = repo / "chapter_list.cpp"
         p = run("cmake", f"-DSOURCE_DIR={repo}", f"-DOUTPUT={generated}", "-P",
