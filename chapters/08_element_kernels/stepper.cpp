@@ -195,6 +195,7 @@ ElementKernelsStepper::ElementKernelsStepper(const Scene& scene, const SolverSet
   shapes_.reserve(model_.tets.size());
   for (const ElementRest& rest : model_.rest) shapes_.push_back(make_element_shape(rest, lame));
   rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());  // the rest shape
+  previous_rotations_ = rotations_;
 
   // The pattern, once: a block per pair of nodes that share a tetrahedron. Where each
   // element's 16 blocks sit, the diagonal blocks and the transposes are found once too.
@@ -265,7 +266,10 @@ void ElementKernelsStepper::element_pass(const State& state) {
       Ds.col(i) = state.x.segment<3>(3 * t[i + 1]) - state.x.segment<3>(3 * t[0]);
       Dv.col(i) = state.v.segment<3>(3 * t[i + 1]) - state.v.segment<3>(3 * t[0]);
     }
-    const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, rotations_[e], fallbacks);
+    Eigen::Quaterniond q = predicted_rotation(rotations_[e], previous_rotations_[e]);
+    const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks);
+    previous_rotations_[e] = rotations_[e];
+    rotations_[e] = q;
     const Eigen::Matrix<double, 3, 4> r = rotated_gradients(R, shape.Dm_inv);
 
     // b_a += h f_a + h df/dx_a ((h + beta) v) without K0: both are -V P r_a with the linear
