@@ -309,6 +309,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
            << static_cast<long long>(steps) * static_cast<long long>(m);
   }
 
+  const auto mib = [m](std::size_t bytes) { return static_cast<double>(bytes * m) / (1 << 20); };
   const BuildInfo info = build_info();
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
@@ -329,13 +330,14 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       << "| predicted start, Newton, SVD fallback: the stepper's (chapter 08) | " << fast
       << " | " << std::setprecision(2) << svd / fast << "x | - |\n\n";
   out << std::setprecision(1)
-      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data read (bytes) |\n"
-      << "| --- | ---: | ---: | ---: |\n"
+      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data per element "
+         "(bytes) | rest data per step (MiB) |\n"
+      << "| --- | ---: | ---: | ---: | ---: |\n"
       << "| sixteen `-R K0_ab R^T` from the stored K0 (chapter 07) | " << stored << " | 1.00x | "
-      << sizeof(ElementRest) << " |\n"
-      << "| ten closed-form blocks from the shape gradients (chapter 08) | " << closed << " | "
-      << std::setprecision(2) << stored / closed << "x | " << sizeof(ch08::ElementShape)
-      << " |\n\n";
+      << sizeof(ElementRest) << " | " << std::setprecision(2) << mib(sizeof(ElementRest)) << " |\n"
+      << std::setprecision(1) << "| ten closed-form blocks from the shape gradients (chapter 08) | "
+      << closed << " | " << std::setprecision(2) << stored / closed << "x | "
+      << sizeof(ch08::ElementShape) << " | " << mib(sizeof(ch08::ElementShape)) << " |\n\n";
   out << std::setprecision(1) << "Step 21 of the " << bench_scene.name << " scene on "
       << std::filesystem::path(bench_scene.mesh.file).filename().string() << " ("
       << bench_scene.mesh.num_tets() << " tets); median of " << repeat

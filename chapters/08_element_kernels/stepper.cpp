@@ -254,7 +254,7 @@ void ElementKernelsStepper::start_system(const State& state) {
 
 void ElementKernelsStepper::element_pass(const State& state) {
   const double h = scene_.dt, beta = scene_.damping.beta;
-  const double c = h + beta;              // b's df/dx term acts on (h + beta) v
+  const double c = h + beta;                  // b's df/dx term acts on (h + beta) v
   const double stiffness = h * beta + h * h;  // A = ... - (h beta + h^2) df/dx
   long long fallbacks = 0;
   std::array<Eigen::Matrix3d, 10> K;
