@@ -194,7 +194,9 @@ ElementKernelsStepper::ElementKernelsStepper(const Scene& scene, const SolverSet
       lame_from_young_poisson(scene.material.youngs_modulus, scene.material.poisson_ratio);
   shapes_.reserve(model_.tets.size());
   for (const ElementRest& rest : model_.rest) shapes_.push_back(make_element_shape(rest, lame));
-  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());  // the rest shape
+  // The rest shape's, as a start: a stepper created on a deformed body (the viewer switching
+  // chapters) starts cold, and Newton or the SVD fallback finds the rotations.
+  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());
   previous_rotations_ = rotations_;
 
   // The pattern, once: a block per pair of nodes that share a tetrahedron. Where each
@@ -268,7 +270,8 @@ void ElementKernelsStepper::element_pass(const State& state) {
     }
     Eigen::Quaterniond q = predicted_rotation(rotations_[e], previous_rotations_[e]);
     const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks);
-    previous_rotations_[e] = rotations_[e];
+    // The first step has no angular velocity to extrapolate: the next starts from R itself.
+    previous_rotations_[e] = first_step_ ? q : rotations_[e];
     rotations_[e] = q;
     const Eigen::Matrix<double, 3, 4> r = rotated_gradients(R, shape.Dm_inv);
 
@@ -290,6 +293,7 @@ void ElementKernelsStepper::element_pass(const State& state) {
       if (a != b) A_.blocks[block[4 * b + a]] += K[p].transpose();
     }
   }
+  first_step_ = false;
   last_step_fallbacks_ = fallbacks;
   total_fallbacks_ += fallbacks;
 }

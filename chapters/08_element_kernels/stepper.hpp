@@ -144,6 +144,7 @@ class ElementKernelsStepper final : public Stepper {
   std::vector<ElementShape> shapes_;
   std::vector<Eigen::Quaterniond> rotations_;           // R_e of the last step
   std::vector<Eigen::Quaterniond> previous_rotations_;  // R_e of the step before
+  bool first_step_ = true;
   long long last_step_fallbacks_ = 0, total_fallbacks_ = 0;
   std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b) in A
   BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the mesh's block pattern
