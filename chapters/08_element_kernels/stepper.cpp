@@ -397,6 +397,13 @@ PcgResult pcg_solve(const BlockSparseMatrix& A, const std::vector<int>& diagonal
     while (result.iterations < settings.max_iterations) {
       A.multiply(p, q);
       const double step = rho / p.dot(q);
+      // An overflowing system (an absurd E) stays finite through the closed-form kernels,
+      // where K0 overflowed at once; it overflows here instead. Stop before y does, with a
+      // residual that says so, rather than iterate on NaN up to the cap.
+      if (!std::isfinite(step)) {
+        residual_norm2 = std::numeric_limits<double>::quiet_NaN();
+        break;
+      }
       y += step * p;
       r -= step * q;
       filter(constraints, r);

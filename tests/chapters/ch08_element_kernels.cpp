@@ -232,6 +232,22 @@ TEST_CASE("ch08: no element of the test scenes needs the SVD fallback", "[ch08]"
   }
 }
 
+TEST_CASE("ch08: an overflowing system stops the solve at once and says so", "[ch08]") {
+  // With E = 1e306 the closed-form blocks stay finite (V mu and V lambda are), and the
+  // overflow appears inside the CG: it must stop there, not run to the cap on NaN.
+  Scene scene = test::test_scene("cantilever");
+  scene.material.youngs_modulus = 1e306;
+  ch08::ElementKernelsStepper stepper(scene, {});
+  State state = rest_state(scene);
+  stepper.step(state);
+  const StepProfile& p = stepper.profile();
+  CHECK(p.cg_iterations < SolverSettings{}.max_iterations);
+  CHECK_FALSE(std::isfinite(p.relative_residual));
+  CHECK(state.x.allFinite());
+  REQUIRE(divergence(state, p) != nullptr);
+  CHECK(std::string(divergence(state, p)).find("residual is not finite") != std::string::npos);
+}
+
 TEST_CASE("ch08: zero heap allocations per step after the first", "[ch08][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();
   for (const Scene& scene :
