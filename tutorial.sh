@@ -143,6 +143,7 @@ docs() {
   "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
   log "results tables and plots"
   "$VENV/bin/python" scripts/update_docs.py --images docs/images
   log "chapter diffs (docs/diffs/)"

@@ -5,15 +5,15 @@
 //   dfdx-fill  chapter 03: df/dx construction by coeffRef, by setFromTriplets, by the table
 //   spmv       chapter 07: SpMV by Eigen (both storage orders) and by 3x3 blocks (full and
 //              symmetric storage), and block Jacobi against scalar Jacobi in the PCG
-//   threads-element  chapter 09: the element pass in parallel by per-node gather and by
-//              colouring, on one thread and on all of them
+//   rotations  chapter 08: per element, the rotation by JacobiSVD and by Newton (cold and
+//              warm-started), the element blocks from a stored K0 and in closed form
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -21,12 +21,11 @@
 #include "chapters/02_noalias/statements.hpp"
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
-#include "chapters/09_threads/stepper.hpp"
+#include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/model.hpp"
-#include "common/threads.hpp"
 
 namespace {
 
@@ -203,46 +202,136 @@ std::string spmv_table(const Scene& scene, int steps) {
   return out.str();
 }
 
-// Chapter 09's two race-free element passes, each on one thread and on all threads: the
-// steppers run interleaved, one step each in turn, and the element phases are timed.
-std::string threads_element_table(const Scene& scene, int steps) {
-  struct Run {
-    const char* name;
-    ch09::ElementParallelism how;
-    int threads;
-    std::unique_ptr<ch09::ThreadsStepper> stepper;
-    State state;
-    std::vector<double> forces_ms, dfdx_ms;
-  };
-  const int all = max_threads();
-  std::vector<Run> runs;
-  for (const auto& [name, how] : {std::pair{"per-node gather", ch09::ElementParallelism::gather},
-                                  std::pair{"colouring", ch09::ElementParallelism::colouring}})
-    for (const int threads : all > 1 ? std::vector<int>{1, all} : std::vector<int>{1})
-      runs.push_back({name, how, threads,
-                      std::make_unique<ch09::ThreadsStepper>(scene, SolverSettings{}, how),
-                      rest_state(scene), {}, {}});
-  for (int k = 0; k < steps + 2; ++k)
-    for (Run& run : runs) {
-      const ThreadCountScope threads(run.threads);
-      run.stepper->step(run.state);
-      if (k < 2) continue;  // the first steps set up the thread pool and the caches
-      run.forces_ms.push_back(1e3 * run.stepper->profile().forces.seconds);
-      run.dfdx_ms.push_back(1e3 * run.stepper->profile().dfdx.seconds);
+// The polar rotation through Eigen's closed-form 3x3 eigensolver of F^T F = V L V^T:
+// R = F V L^-1/2 V^T. Fast, but it squares F's condition number and knows no inversion.
+Eigen::Matrix3d polar_by_eigensolver(const Eigen::Matrix3d& F) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(F.transpose() * F);
+  const Eigen::Matrix3d& V = eigen.eigenvectors();
+  return F * V * eigen.eigenvalues().cwiseSqrt().cwiseInverse().asDiagonal() * V.transpose();
+}
+
+std::string rotations_table(const Scene& bench_scene, int steps) {
+  // Deformation gradients of a real step, and the rotations of the step before: the warm
+  // start the stepper has.
+  ch08::ElementKernelsStepper stepper(bench_scene, {});
+  State state = rest_state(bench_scene);
+  for (int k = 0; k < 20; ++k) stepper.step(state);
+  const Model model(bench_scene);
+  const std::size_t m = model.tets.size();
+  std::vector<Eigen::Matrix3d> F(m), R(m);
+  for (std::size_t e = 0; e < m; ++e)
+    F[e] = deformation_gradient(model.rest[e], gather(state.x, model.tets[e]));
+  const std::vector<Eigen::Quaterniond> previous = stepper.rotations();
+  std::vector<Eigen::Quaterniond> q(m);
+
+  const int repeat = std::max(5, steps);
+  const double to_ns = 1e6 / static_cast<double>(m);  // median ms of a sweep -> ns/element
+  long long fallbacks = 0;
+  // Newton's iterations summed over the elements, and the elements where it cannot decide.
+  struct Count {
+    long long iterations = 0, undecided = 0;
+    void add(int k) { k > 0 ? iterations += k : ++undecided; }
+    std::string mean(std::size_t elements) const {
+      std::ostringstream s;
+      s << std::fixed << std::setprecision(2)
+        << static_cast<double>(iterations) / static_cast<double>(elements - undecided);
+      if (undecided > 0) s << " (" << undecided << " undecided)";
+      return s.str();
     }
+  } count_cold, count_warm;
+  const double svd = to_ns * time_ms(repeat, [&] {
+    for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(F[e]);
+  });
+  const double eigensolver = to_ns * time_ms(repeat, [&] {
+    for (std::size_t e = 0; e < m; ++e) R[e] = polar_by_eigensolver(F[e]);
+  });
+  const double cold = to_ns * time_ms(repeat, [&] {
+    count_cold = Count{};
+    for (std::size_t e = 0; e < m; ++e) {
+      q[e] = Eigen::Quaterniond::Identity();
+      count_cold.add(ch08::newton_polar_rotation(F[e], q[e]));
+    }
+  });
+  const double warm = to_ns * time_ms(repeat, [&] {
+    count_warm = Count{};
+    for (std::size_t e = 0; e < m; ++e) {
+      q[e] = previous[e];
+      count_warm.add(ch08::newton_polar_rotation(F[e], q[e]));
+    }
+  });
+  const double fast = to_ns * time_ms(repeat, [&] {
+    for (std::size_t e = 0; e < m; ++e) {
+      q[e] = previous[e];
+      R[e] = ch08::fast_polar_rotation(F[e], q[e], fallbacks);
+    }
+  });
+  double difference = 0.0;  // the answers, against common/'s
+  for (std::size_t e = 0; e < m; ++e)
+    difference = std::max(difference, (R[e] - polar_rotation(F[e])).cwiseAbs().maxCoeff());
+
+  // The element blocks: sixteen -R K0_ab R^T from the stored K0 (chapter 07), against the
+  // ten distinct blocks in closed form from the shape gradients (chapter 08).
+  std::vector<ch08::ElementShape> shapes = stepper.shapes();
+  Eigen::Matrix3d sink = Eigen::Matrix3d::Zero();  // keeps the blocks from being optimized out
+  const double stored = to_ns * time_ms(repeat, [&] {
+    for (std::size_t e = 0; e < m; ++e)
+      for (int ab = 0; ab < 16; ++ab) sink += dfdx_block(model.rest[e], R[e], ab / 4, ab % 4);
+  });
+  std::array<Eigen::Matrix3d, 10> K;
+  const double closed = to_ns * time_ms(repeat, [&] {
+    for (std::size_t e = 0; e < m; ++e) {
+      ch08::stiffness_blocks(ch08::rotated_gradients(R[e], shapes[e].Dm_inv), shapes[e].mu_volume,
+                             shapes[e].lambda_volume, K);
+      for (const Eigen::Matrix3d& k : K) sink += k;
+    }
+  });
+
+  // How often the stepper falls back to the SVD on the benchmark's scenes.
+  std::ostringstream scenes;
+  for (const std::string& name : scene_names()) {
+    Scene scene = make_scene(name, bench_scene.mesh, bench_scene.material);
+    scene.dt = bench_scene.dt;
+    ch08::ElementKernelsStepper run(scene, {});
+    State s = rest_state(scene);
+    for (int k = 0; k < steps; ++k) run.step(s);
+    scenes << (scenes.tellp() > 0 ? ", " : "") << name << " " << run.total_fallbacks() << " of "
+           << static_cast<long long>(steps) * static_cast<long long>(m);
+  }
+
   const BuildInfo info = build_info();
   std::ostringstream out;
-  out << std::fixed << std::setprecision(3)
-      << "| element pass | threads | forces (ms) | df/dx construction (ms) | both (ms) |\n"
-      << "| --- | ---: | ---: | ---: | ---: |\n";
-  for (const Run& run : runs)
-    out << "| " << run.name << " | " << run.threads << " | " << median(run.forces_ms) << " | "
-        << median(run.dfdx_ms) << " | " << median(run.forces_ms) + median(run.dfdx_ms) << " |\n";
-  out << "\nMedians of " << steps << " steps of the " << scene.name << " scene on "
-      << std::filesystem::path(scene.mesh.file).filename().string() << " ("
-      << scene.mesh.num_tets() << " tets; the colouring has " << runs.back().stepper->colours()
-      << " colours of groups of 16 elements); " << cpu_model() << ", " << info.compiler
-      << ", `" << info.flags << "`. Generated by `fem_lessons threads-element`.\n";
+  out << std::fixed << std::setprecision(1);
+  out << "| rotation of one element | ns per element | vs JacobiSVD | iterations |\n"
+      << "| --- | ---: | ---: | ---: |\n"
+      << "| `JacobiSVD<Matrix3d>`, U V^T (common/, chapters 01-07) | " << svd << " | 1.00x | - |\n"
+      << "| `SelfAdjointEigenSolver::computeDirect` of F^T F (no inversion, squared condition) | "
+      << eigensolver << " | " << std::setprecision(2) << svd / eigensolver << "x | - |\n"
+      << std::setprecision(1) << "| Newton, cold (from the identity) | " << cold << " | "
+      << std::setprecision(2) << svd / cold << "x | " << count_cold.mean(m) << " |\n"
+      << std::setprecision(1) << "| Newton, warm (from the previous step's rotation) | " << warm
+      << " | " << std::setprecision(2) << svd / warm << "x | " << count_warm.mean(m) << " |\n"
+      << std::setprecision(1)
+      << "| warm Newton with the SVD fallback, as the stepper calls it (chapter 08) | " << fast
+      << " | " << std::setprecision(2) << svd / fast << "x | - |\n\n";
+  out << std::setprecision(1)
+      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data read (bytes) |\n"
+      << "| --- | ---: | ---: | ---: |\n"
+      << "| sixteen `-R K0_ab R^T` from the stored K0 (chapter 07) | " << stored << " | 1.00x | "
+      << sizeof(ElementRest) << " |\n"
+      << "| ten closed-form blocks from the shape gradients (chapter 08) | " << closed << " | "
+      << std::setprecision(2) << stored / closed << "x | " << sizeof(ch08::ElementShape)
+      << " |\n\n";
+  out << std::setprecision(1) << "Step 21 of the " << bench_scene.name << " scene on "
+      << std::filesystem::path(bench_scene.mesh.file).filename().string() << " ("
+      << bench_scene.mesh.num_tets() << " tets); median of " << repeat
+      << " sweeps over all elements. Largest difference from common/'s rotation: "
+      << std::scientific << std::setprecision(1) << difference << std::fixed
+      << ". SVD fallbacks of the stepper over " << steps << " steps (elements x steps): "
+      << scenes.str() << ". " << cpu_model() << ", " << info.compiler << ", `" << info.flags
+      << "`. Generated by `fem_lessons rotations`.\n";
+  volatile double keep = sink.sum();
+  (void)keep;
   return out.str();
 }
 
@@ -263,18 +352,18 @@ void write_between_markers(const std::string& path, const std::string& name,
 }
 
 const char* const kUsage =
-    "usage: fem_lessons [noalias|dfdx-fill|spmv [options]]\n"
+    "usage: fem_lessons [noalias|dfdx-fill|spmv|rotations [options]]\n"
     "  noalias    allocations of each vector statement of chapter 01 and its chapter 02 rewrite\n"
     "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n"
     "  spmv       SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi\n"
-    "  threads-element  chapter 09's element pass: per-node gather against colouring\n"
+    "  rotations  per element: rotation by SVD and by Newton; blocks from K0 and closed form\n"
     "without a lesson: every lesson in turn, with its defaults\n";
 
 // One lesson with its options (argv[0] is the lesson's name); returns the exit status.
 int run_lesson(const std::string& lesson, int argc, char** argv) {
   ArgParser args("fem_lessons " + lesson, "Prints the lesson's table in Markdown.");
   add_scene_options(args, lesson == "noalias" ? "meshes/test_beam.msh" : "meshes/plate_poster.msh");
-  args.option("steps", "N", "measured steps (dfdx-fill)", "50");
+  args.option("steps", "N", "measured steps (dfdx-fill, rotations)", "50");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
   try {
     if (!args.parse(argc, argv)) return 0;
@@ -283,7 +372,7 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
     if (steps <= 0) throw UsageError("--steps must be positive");
     const std::string table = lesson == "noalias"     ? noalias_table(scene)
                               : lesson == "dfdx-fill" ? dfdx_fill_table(scene, steps)
-                              : lesson == "threads-element" ? threads_element_table(scene, steps)
+                              : lesson == "rotations" ? rotations_table(scene, steps)
                                                       : spmv_table(scene, steps);
     std::cout << table;
     if (const std::string& readme = args.get("readme"); !readme.empty()) {
@@ -303,7 +392,7 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string> lessons = {"noalias", "dfdx-fill", "spmv", "threads-element"};
+  const std::vector<std::string> lessons = {"noalias", "dfdx-fill", "spmv", "rotations"};
   if (argc < 2) {  // every lesson, as the README of its chapter shows it
     for (const std::string& lesson : lessons) {
       std::cout << "\n## fem_lessons " << lesson << "\n\n" << std::flush;

@@ -9,6 +9,7 @@
 #include "chapters/05_inplace_constraints/stepper.hpp"
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
+#include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/09_threads/stepper.hpp"
 
 namespace fem {
@@ -35,6 +36,8 @@ const std::vector<ChapterInfo>& chapters() {
                                                "S A S^T applied in place, no S"),
       chapter<ch06::CustomPcgStepper>("06_custom_pcg", "our own PCG: warm start, no allocations"),
       chapter<ch07::BlockSparseStepper>("07_block_sparse", "3x3 block sparse matrix, block Jacobi"),
+      chapter<ch08::ElementKernelsStepper>(
+          "08_element_kernels", "warm-started rotations, closed-form blocks, one fused pass"),
       chapter<ch09::ThreadsStepper>("09_threads", "every core, the same answer for any thread count"),
   };
   return list;

@@ -7,7 +7,9 @@ import sys
 PHASES = ["dfdx", "compose", "constraints", "solve", "step"]
 ALL_PHASES = ["forces"] + PHASES
 PHASE_LABELS = {
-    "forces": "forces (shared)",
+    # common/'s element kernels in chapters 01-07; chapter 08's fused element pass, which
+    # also does the work of df/dx construction and most of the composition (its dfdx is 0)
+    "forces": "forces",
     "dfdx": "df/dx construction",
     "compose": "system composition",
     "constraints": "constraints",
