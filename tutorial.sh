@@ -33,6 +33,9 @@ commands:
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
+  threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
+             thread on the poster-sized mesh: results/threads.json and results/threads.png
+             (step and solve time against threads, with the ideal line)
   docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
              the README and the chapter READMEs, plots copied to docs/images/), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
@@ -129,6 +132,17 @@ bench() {
   fi
 }
 
+threads() {
+  build
+  mkdir -p results
+  local counts
+  counts=$(seq -s, 1 "$(nproc)")
+  log "chapter 09 at $counts threads (chapter 08 beside it, one thread) on the poster-sized mesh"
+  "$BUILD_DIR/fem_bench" --chapters 08,09 --threads "$counts" --no-solvers \
+    --json results/threads.json "$@"
+  "$VENV/bin/python" scripts/plot_results.py --threads results/threads.json --out results
+}
+
 scaling() {
   build
   log "scaling over the beam series (a time budget per run; --help for the options)"
@@ -144,6 +158,7 @@ docs() {
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
   log "results tables and plots"
   "$VENV/bin/python" scripts/update_docs.py --images docs/images
   log "chapter diffs (docs/diffs/)"
@@ -193,6 +208,7 @@ main() {
     test) run_tests "$@" ;;
     bench) bench "$@" ;;
     scaling) scaling "$@" ;;
+    threads) threads "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;

@@ -18,7 +18,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (ALL_PHASES, BASELINE, PHASE_LABELS, PHASES, POSTER_SOLVE_MS,  # noqa: E402
-                            POSTER_SPEEDUPS, ResultsError, die, load_checked)
+                            POSTER_SPEEDUPS, ResultsError, chapter_dir, die, load_checked)
 
 
 def ms(x):
@@ -134,7 +134,7 @@ def headline(data):
     base = by.get(BASELINE)
     rows = []
     for c in data["chapters"]:
-        rows.append([f"[`{c['chapter']}`](chapters/{c['chapter']}/README.md)", ms(c["median_ms"]["step"]),
+        rows.append([f"[`{c['chapter']}`](chapters/{chapter_dir(c['chapter'])}/README.md)", ms(c["median_ms"]["step"]),
                      ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-",
                      f"{c['allocations_per_step']:g}"])
     mesh, b = data["mesh"], data["build"]
@@ -164,8 +164,9 @@ def chapter_map(data):
             phase = max(PHASES[:-1], key=lambda p: previous["median_ms"][p] / max(c["median_ms"][p], 1e-9))
             moved = (f"{PHASE_LABELS[phase]} {ratio(previous['median_ms'][phase], c['median_ms'][phase])} "
                      f"over `{previous['chapter']}`")
-        diff = f"[diff](docs/diffs/{name}.diff)" if previous is not None else ""
-        rows.append([f"[`{name}`](chapters/{name}/README.md)", c.get("title", ""), moved,
+        diff = f"[diff](docs/diffs/{chapter_dir(name)}.diff)" if previous is not None and \
+            chapter_dir(previous["chapter"]) != chapter_dir(name) else ""
+        rows.append([f"[`{name}`](chapters/{chapter_dir(name)}/README.md)", c.get("title", ""), moved,
                      ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-", diff])
         previous = c
     return table(["chapter", "the idea", "the phase it moves most", "step speedup over 01", "diff"],
@@ -253,7 +254,7 @@ def main():
         readme["viewer-fps"] = viewer_table(viewer)
     update_file(root / "README.md", readme)
     for c in data["chapters"]:
-        update_file(root / "chapters" / c["chapter"] / "README.md",
+        update_file(root / "chapters" / chapter_dir(c["chapter"]) / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),
                      "results:solvers": solvers})
     if args.images:

@@ -68,7 +68,9 @@ def main():
         out = tmp / "plots"
         p = run(SCRIPTS / "plot_results.py", FIXTURE, "--scaling", scaling, "--out", out)
         check("plot_results.py exits 0", p.returncode == 0, p.stderr)
-        for png in ["phases", "speedup", "allocations", "solvers", "scaling"]:
+        p = run(SCRIPTS / "plot_results.py", "--threads", FIXTURE, "--out", out)
+        check("plot_results.py --threads exits 0", p.returncode == 0, p.stderr)
+        for png in ["phases", "speedup", "allocations", "solvers", "scaling", "threads"]:
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
                   f"{f} missing or small")
@@ -117,6 +119,9 @@ def main():
         broken = copy.deepcopy(bench)
         del broken["chapters"][0]["median_ms"]["solve"]
         check("a missing phase is caught", validate_bench(broken) != [])
+        broken = copy.deepcopy(bench)
+        broken["chapters"][-1]["threads"] = 0
+        check("a thread count below 1 is caught", validate_bench(broken) != [])
         broken = copy.deepcopy(bench)
         broken["cg_tolerance"] = "tight"
         check("a wrong type is caught", validate_bench(broken) != [])
