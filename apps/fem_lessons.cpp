@@ -25,6 +25,7 @@
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
+#include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
@@ -340,6 +341,43 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
   return out.str();
 }
 
+// The block SpMV of chapter 09's PCG (the rows in fixed chunks, a static schedule, a barrier
+// after each product) on the scene's system, at each thread count, in GB/s of what one
+// product must read at least: the blocks and their column indices.
+std::string threads_spmv_rows(const Scene& scene, const std::vector<int>& thread_counts) {
+  ch09::ThreadsStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  const ch09::BlockSparseMatrix& A = stepper.system_matrix();
+  const ch09::RowChunks chunks(A);
+  const Eigen::VectorXd x = Eigen::VectorXd::Ones(3 * A.block_rows());
+  Eigen::VectorXd y(x.size());
+  const int products = 100;
+  const double bytes = static_cast<double>(A.blocks.size()) * (sizeof(Eigen::Matrix3d) + sizeof(int));
+  std::ostringstream out;
+  out << std::fixed << "| block SpMV, " << A.blocks.size() << " blocks ("
+      << std::setprecision(2) << bytes / 1e6 << " MB) | threads | us per product | GB/s | speedup |\n"
+      << "| --- | ---: | ---: | ---: | ---: |\n";
+  double one = 0.0;
+  for (const int threads : thread_counts) {
+    const ThreadCountScope scope(threads);
+    const double us = 1e3 / products * time_ms(7, [&] {
+      ch09::run_parallel([&] {
+        for (int k = 0; k < products; ++k) {
+#pragma omp for schedule(static)
+          for (int c = 0; c < chunks.count(); ++c)
+            A.multiply_rows(x, y, chunks.start[c], chunks.start[c + 1]);
+        }
+      });
+    });
+    if (one == 0.0) one = us;
+    out << "| " << std::filesystem::path(scene.mesh.file).filename().string() << " | " << threads
+        << " | " << std::setprecision(1) << us << " | " << std::setprecision(1)
+        << bytes / (us * 1e3) << " | " << std::setprecision(2) << one / us << "x |\n";
+  }
+  return out.str();
+}
+
 // Chapter 09's two race-free element passes and chapter 08's serial one: the steppers run
 // interleaved, one step each in turn, and the fused element pass (the forces phase) is timed.
 std::string threads_element_table(const Scene& scene, int steps) {
@@ -377,6 +415,7 @@ std::string threads_element_table(const Scene& scene, int steps) {
     out << "| " << run.name << " | " << run.threads << " | " << median(run.ms) << " | "
         << std::setprecision(2) << serial / median(run.ms) << "x |\n"
         << std::setprecision(3);
+  out << "\n" << threads_spmv_rows(scene, all > 1 ? std::vector<int>{1, all} : std::vector<int>{1});
   out << "\nThe fused element pass (rotations, forces, blocks into A and b), median of " << steps
       << " steps of the " << scene.name << " scene on "
       << std::filesystem::path(scene.mesh.file).filename().string() << " ("

@@ -81,12 +81,13 @@ def main():
         # Tables: a copy of the docs with the markers, filled from the fixture.
         root = tmp / "repo"
         for rel in ["README.md", "docs/results.md", "chapters/01_naive/README.md",
-                    "chapters/06_custom_pcg/README.md"]:
+                    "chapters/06_custom_pcg/README.md", "chapters/09_threads/README.md"]:
             (root / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / rel, root / rel)
         (root / "results").mkdir()
         shutil.copy(FIXTURE, root / "results" / "bench.json")
         shutil.copy(scaling, root / "results" / "scaling.json")
+        shutil.copy(FIXTURE, root / "results" / "threads.json")
         viewer = viewer_fixture(bench)
         (root / "results" / "viewer.json").write_text(json.dumps(viewer))
         p = run(SCRIPTS / "update_docs.py", "--root", root)
@@ -113,6 +114,15 @@ def main():
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
         check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
+        threaded = [c for c in bench["chapters"] if "@" in c["chapter"]]
+        chapter = (root / "chapters" / "09_threads" / "README.md").read_text()
+        check("chapter 09 tables filled: NAME@N rows and the thread table",
+              all(f"bench-table:{c['chapter']}:begin -->\n| median ms" in chapter for c in threaded) and
+              "threads-table:begin -->\n| median ms" in chapter and
+              all(update_docs.ms(c["median_ms"]["step"]) in chapter for c in threaded),
+              chapter[chapter.find("measured effect"):][:800])
+        check("README links NAME@N rows to the chapter's directory",
+              "[`09_threads@2`](chapters/09_threads/README.md)" in readme)
 
         # Schema: the fixture passes, broken copies fail.
         check("fixture matches the schema", validate_bench(bench) == [], str(validate_bench(bench)))
