@@ -315,6 +315,14 @@ void print_solvers(const std::vector<SolverResult>& solvers) {
                  "another order, on N threads)\n";
 }
 
+// The 1-minute load average (/proc/loadavg), -1 where unknown: threads that wait at barriers
+// suffer from every other program on the machine, so the results record how busy it was.
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1.0;
+  return (in >> load) ? load : -1.0;
+}
+
 std::string git_commit() {
   const std::string cmd =
       "git -C '" + source_dir() + "' describe --always --dirty --abbrev=7 2>/dev/null";
@@ -348,7 +356,7 @@ std::string allocations_json(const std::array<long long, 6>& a) {
 
 void write_json(const std::string& path, const Scene& scene, const SolverSettings& solver,
                 int warmup, int steps, const std::vector<ChapterResult>& results,
-                const std::vector<SolverResult>& solvers) {
+                const std::vector<SolverResult>& solvers, double load_before) {
   namespace fs = std::filesystem;
   if (const fs::path dir = fs::path(path).parent_path(); !dir.empty()) fs::create_directories(dir);
   std::ofstream out(path);
@@ -372,7 +380,8 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
       << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
-      << ", \"threads\": " << hardware_threads() << "},\n";
+      << ", \"threads\": " << hardware_threads() << ", \"load_average\": [" << load_before
+      << ", " << load_average() << "]},\n";
   out << "  \"openmp\": " << (openmp_enabled() ? "true" : "false") << ",\n";
   out << "  \"commit\": " << json_string(git_commit()) << ",\n";
   out << "  \"chapters\": [\n";
@@ -526,6 +535,8 @@ int main(int argc, char** argv) {
               << "threads of the parallel chapters:";
     for (const int t : thread_counts) std::cout << " " << t;
     std::cout << (openmp_enabled() ? "" : " (built without OpenMP)") << "\n";
+    const double load_before = load_average();
+    std::cout << "load average (1 min): " << load_before << "\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
     std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";
@@ -541,7 +552,7 @@ int main(int argc, char** argv) {
       print_solvers(solvers);
     }
     if (const std::string& path = args.get("json"); !path.empty()) {
-      write_json(path, scene, solver, warmup, steps, results, solvers);
+      write_json(path, scene, solver, warmup, steps, results, solvers, load_before);
       std::cout << "\nwrote " << path << "\n";
     }
   } catch (const UsageError& e) {
