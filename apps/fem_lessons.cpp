@@ -456,8 +456,10 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
   add_scene_options(args, lesson == "noalias" ? "meshes/test_beam.msh" : "meshes/plate_poster.msh");
   args.option("steps", "N", "measured steps (dfdx-fill, rotations)", "50");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
+  add_thread_option(args);  // threads-element: the count beside one thread
   try {
     if (!args.parse(argc, argv)) return 0;
+    threads_from_args(args);
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
