@@ -44,6 +44,9 @@ commands:
              bar) over a sweep of Young's modulus, with the solve table at each point (about 10
              minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
              scripts/regimes.py (--help)
+  threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
+             thread on the poster-sized mesh: results/threads.json and results/threads.png
+             (step and solve time against threads, with the ideal line)
   docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
@@ -179,6 +182,17 @@ variant() {
   "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
+threads() {
+  quiet_build
+  mkdir -p results
+  local counts
+  counts=$(seq -s, 1 "$(nproc)")
+  log "chapter 09 at $counts threads (chapter 08 beside it, one thread) on the poster-sized mesh"
+  "$BUILD_DIR/fem_bench" --chapters 08,09 --threads "$counts" --no-solvers \
+    --json results/threads.json "$@"
+  "$VENV/bin/python" scripts/plot_results.py --threads results/threads.json --out results
+}
+
 scaling() {
   quiet_build
   log "scaling over the beam series (a time budget per run; --help for the options)"
@@ -201,14 +215,18 @@ docs() {
   "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
-  for json in bench scaling viewer regimes; do
+  for json in bench scaling viewer regimes threads; do
     if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
   done
   "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
   if [ -f docs/data/scaling.json ]; then
     "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+  fi
+  if [ -f docs/data/threads.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --threads docs/data/threads.json --out docs/images
   fi
   if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
   "$VENV/bin/python" scripts/update_docs.py
@@ -262,6 +280,7 @@ main() {
     variant) variant "$@" ;;
     scaling) scaling "$@" ;;
     regimes) regimes "$@" ;;
+    threads) threads "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;

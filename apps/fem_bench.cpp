@@ -19,11 +19,13 @@
 #include <sstream>
 
 #include "chapters/06_custom_pcg/stepper.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "common/alloc_counter.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
+#include "common/threads.hpp"
 
 namespace {
 
@@ -63,11 +65,13 @@ struct ChapterResult {
   double cg_iterations;      // median
   double relative_residual;  // last step
   int not_converged_steps;
+  int threads;  // the thread count of the run: 1 for the single-threaded chapters
 };
 
 // One chapter's stepper, state and samples while the benchmark runs.
 struct ChapterRun {
   const ChapterInfo* chapter;
+  int threads;
   std::unique_ptr<Stepper> stepper;
   State state;
   std::array<std::vector<double>, 6> seconds;
@@ -78,26 +82,36 @@ struct ChapterRun {
 // Runs the chapters interleaved, one step of each in turn: when the machine's speed drifts
 // (a shared virtual machine, a CPU changing its clock), every chapter sees the same drift,
 // so their ratios hold even when the absolute times move.
+// A chapter that uses threads (09 on) runs once per thread count, as "09_threads@2".
 std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& chapters,
                                         const Scene& scene, const SolverSettings& solver,
-                                        int warmup, int steps) {
+                                        const std::vector<int>& thread_counts, int warmup,
+                                        int steps) {
   std::vector<ChapterRun> runs;
-  for (const ChapterInfo* c : chapters)
-    runs.push_back({c,
-                    c->make(scene, solver),
-                    rest_state(scene),
-                    {},
-                    {},
-                    {},
-                    ChapterResult{c->id, c->title, c->variant_of, {}, 0.0, {}, 0, 0.0, 0.0, 0}});
+  for (const ChapterInfo* c : chapters) {
+    std::unique_ptr<Stepper> first = c->make(scene, solver);
+    const bool threaded = first->uses_threads();
+    for (const int threads : threaded ? thread_counts : std::vector<int>{1})
+      runs.push_back({c,
+                      threads,
+                      first ? std::move(first) : c->make(scene, solver),
+                      rest_state(scene),
+                      {},
+                      {},
+                      {},
+                      ChapterResult{threaded ? c->id + "@" + std::to_string(threads) : c->id,
+                                    c->title, c->variant_of, {}, 0.0, {}, 0, 0.0, 0.0, 0,
+                                    threads}});
+  }
   const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
     for (ChapterRun& run : runs) {
+      set_threads(run.threads);  // the next parallel region's team; no cost between steps
       alloc::Scope counter;
       run.stepper->step(run.state);
       const long long allocs = counter.allocations();
       if (const char* why = divergence(run.state, run.stepper->profile()))
-        throw std::runtime_error(run.chapter->id + ": the simulation diverged at step " +
+        throw std::runtime_error(run.result.chapter + ": the simulation diverged at step " +
                                  std::to_string(k + 1) + " (" + why + ")");
       if (k < warmup) continue;
       ChapterResult& r = run.result;
@@ -157,6 +171,9 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   Eigen::CholmodSupernodalLLT<SparseMatrix> cholmod;
 #endif
   std::vector<Samples> samples(names.size());
+  // One thread for these rows: with OpenMP compiled in, Eigen's Lower|Upper CG would use
+  // every core (Eigen/src/SparseCore/SparseDenseProduct.h); the threaded rows follow.
+  Eigen::setNbThreads(1);
   ch06::CustomPcgStepper stepper(scene, settings);
   State state = rest_state(scene);
   Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x, ours;
@@ -251,6 +268,74 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   return out;
 }
 
+// The threaded rows of the solve table, on chapter 09's systems (the same filtered systems
+// as chapter 06's, assembled in another order): stock Eigen's one threaded configuration,
+// ConjugateGradient<RowMajor, Lower|Upper> with Eigen::setNbThreads(n) (its SpMV is an
+// OpenMP loop over rows, Eigen/src/SparseCore/SparseDenseProduct.h), against chapter 09's
+// solver with n OpenMP threads. Both start from the previous system's solution.
+std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverSettings& settings,
+                                               const std::vector<int>& thread_counts, int warmup,
+                                               int steps) {
+  using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  struct Row {
+    std::string name;
+    int threads;
+    bool eigen;
+    std::vector<double> ms, iterations, allocations;
+  };
+  std::vector<Row> rows;
+  for (const bool eigen : {true, false})
+    for (const int t : thread_counts)
+      rows.push_back({(eigen ? "eigen_cg_rowmajor@" : "pcg_ch09@") + std::to_string(t), t, eigen, {}, {}, {}});
+  ch09::ThreadsStepper stepper(scene, settings);
+  State state = rest_state(scene);
+  ch09::ParallelPcg pcg(stepper.system_matrix(), stepper.diagonal_blocks(), scene.constraints);
+  Eigen::ConjugateGradient<RowMajorMatrix, Eigen::Lower | Eigen::Upper> cg;
+  cg.setTolerance(settings.tolerance);
+  cg.setMaxIterations(settings.max_iterations);
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x, next;
+  for (int k = 0; k < warmup + steps; ++k) {
+    stepper.step(state);
+    const RowMajorMatrix A = stepper.system_matrix().to_sparse();  // not timed
+    const Eigen::VectorXd& b = stepper.system_rhs();
+    for (Row& row : rows) {
+      set_threads(row.threads);
+      Eigen::setNbThreads(row.threads);
+      alloc::Scope scope;
+      const auto start = std::chrono::steady_clock::now();
+      int iterations = 0;
+      if (row.eigen) {
+        cg.compute(A);
+        x = cg.solveWithGuess(b, previous);
+        iterations = static_cast<int>(cg.iterations());
+      } else {
+        x = previous;
+        iterations = pcg.solve(stepper.system_matrix(), b, settings, x).iterations;
+      }
+      const double ms =
+          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const long long allocations = scope.allocations();
+      if (!row.eigen && row.threads == thread_counts.front()) next = x;
+      if (k < warmup) continue;
+      row.ms.push_back(ms);
+      row.iterations.push_back(iterations);
+      row.allocations.push_back(static_cast<double>(allocations));
+    }
+    previous = next;
+  }
+  Eigen::setNbThreads(1);
+  std::vector<SolverResult> out;
+  for (const Row& row : rows) {
+    SolverResult r;
+    r.name = row.name;
+    r.median_ms = r.solve_ms = spread(row.ms).median;  // with compute(): a diagonal, microseconds
+    r.iterations = spread(row.iterations).median;
+    r.allocations_per_solve = spread(row.allocations).median;
+    out.push_back(r);
+  }
+  return out;
+}
+
 void print_solvers(const std::vector<SolverResult>& solvers) {
   std::cout << "\nsolve table (the filtered systems of chapter 06's run; same tolerance)\n"
             << std::left << std::setw(21) << "solver" << std::right << std::setw(11) << "median ms"
@@ -267,6 +352,17 @@ void print_solvers(const std::vector<SolverResult>& solvers) {
   std::cout << "(setup: compute() or factorize() after one analyzePattern; iterations: Eigen counts"
                " the products of full iterations, the last one excluded; pcg_ch06 counts every"
                " product)\n";
+  if (solvers.back().name.find('@') != std::string::npos)
+    std::cout << "(rows NAME@N: chapter 09's systems, the same filtered systems assembled in "
+                 "another order, on N threads)\n";
+}
+
+// The 1-minute load average (/proc/loadavg), -1 where unknown: threads that wait at barriers
+// suffer from every other program on the machine, so the results record how busy it was.
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1.0;
+  return (in >> load) ? load : -1.0;
 }
 
 std::string git_commit() {
@@ -302,7 +398,7 @@ std::string allocations_json(const std::array<long long, 6>& a) {
 
 void write_json(const std::string& path, const Scene& scene, const SolverSettings& solver,
                 int warmup, int steps, const std::vector<ChapterResult>& results,
-                const std::vector<SolverResult>& solvers) {
+                const std::vector<SolverResult>& solvers, double load_before) {
   namespace fs = std::filesystem;
   if (const fs::path dir = fs::path(path).parent_path(); !dir.empty()) fs::create_directories(dir);
   std::ofstream out(path);
@@ -326,7 +422,9 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
       << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
-      << ", \"threads\": " << hardware_threads() << "},\n";
+      << ", \"threads\": " << hardware_threads() << ", \"load_average\": [" << load_before
+      << ", " << load_average() << "]},\n";
+  out << "  \"openmp\": " << (openmp_enabled() ? "true" : "false") << ",\n";
   out << "  \"commit\": " << json_string(git_commit()) << ",\n";
   out << "  \"chapters\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
@@ -343,7 +441,8 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
         << ", \"allocations_max\": " << r.allocations_max
         << ", \"cg_iterations\": " << r.cg_iterations
         << ", \"relative_residual\": " << r.relative_residual
-        << ", \"not_converged_steps\": " << r.not_converged_steps << "}"
+        << ", \"not_converged_steps\": " << r.not_converged_steps << ", \"threads\": " << r.threads
+        << "}"
         << (i + 1 < results.size() ? "," : "") << "\n";
   }
   out << "  ]";
@@ -395,6 +494,34 @@ void print_table(const std::vector<ChapterResult>& results) {
   }
 }
 
+// "1,2,4" -> {1, 2, 4}; empty -> 1 and OpenMP's count (OMP_NUM_THREADS or every core).
+std::vector<int> parse_thread_counts(const std::string& list) {
+  std::vector<int> out;
+  if (list.empty()) {
+    out = {1};
+    if (max_threads() > 1) out.push_back(max_threads());
+    return out;
+  }
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    int n = 0;
+    try {
+      n = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || n < 1)
+      throw UsageError("--threads expects thread counts >= 1 separated by commas, got '" + list +
+                       "'");
+    if (n > 1 && !openmp_enabled())
+      throw UsageError("--threads " + item + ": this build has no OpenMP (FEM_OPENMP=OFF)");
+    if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
+  }
+  return out;
+}
+
 std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
   std::vector<const ChapterInfo*> out;
   if (list == "all") {
@@ -436,6 +563,11 @@ int main(int argc, char** argv) {
   args.option("out", "DIR", "the run's folder: writes DIR/bench.json ('' for nowhere)", "results");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
   args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
+  args.option("threads", "LIST",
+              "thread counts for the parallel chapters (09 on), comma-separated (default: 1 and "
+              "OMP_NUM_THREADS, else 1 and all " +
+                  std::to_string(hardware_threads()) + ")",
+              "");
   try {
     if (!args.parse(argc, argv)) return 0;
     const auto selected = parse_chapters(args.get("chapters"));
@@ -443,6 +575,7 @@ int main(int argc, char** argv) {
     if (steps <= 0) throw UsageError("--steps must be positive");
     if (warmup < 0) throw UsageError("--warmup must be >= 0");
     const SolverSettings solver = solver_from_args(args);
+    const std::vector<int> thread_counts = parse_thread_counts(args.get("threads"));
     const Scene scene = scene_from_args(args);
     const BuildInfo b = build_info();
     std::cout << "fem_bench: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
@@ -450,22 +583,29 @@ int main(int argc, char** argv) {
               << scene.dt << " s, " << warmup << " warm-up + " << steps
               << " measured steps, CG tol " << solver.tolerance << "\n"
               << "build: " << b.compiler << ", " << b.flags << ", Eigen " << b.eigen << "; CPU "
-              << cpu_model() << "\n";
+              << cpu_model() << "\n"
+              << "threads of the parallel chapters:";
+    for (const int t : thread_counts) std::cout << " " << t;
+    std::cout << (openmp_enabled() ? "" : " (built without OpenMP)") << "\n";
+    const double load_before = load_average();
+    std::cout << "load average (1 min): " << load_before << "\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
     std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";
-    const std::vector<ChapterResult> results = run_chapters(selected, scene, solver, warmup, steps);
+    const std::vector<ChapterResult> results = run_chapters(selected, scene, solver, thread_counts, warmup, steps);
     print_table(results);
     std::vector<SolverResult> solvers;
     if (!args.has_flag("no-solvers")) {
       std::cout << "\n  running the solve table ..." << std::flush;
       solvers = run_solvers(scene, solver, warmup, steps);
+      for (auto& s : run_threaded_solvers(scene, solver, thread_counts, warmup, steps))
+        solvers.push_back(std::move(s));
       std::cout << " done\n";
       print_solvers(solvers);
     }
     if (const std::string path = json_path(args); !path.empty()) {
       const bool replaced = std::filesystem::exists(path);
-      write_json(path, scene, solver, warmup, steps, results, solvers);
+      write_json(path, scene, solver, warmup, steps, results, solvers, load_before);
       std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there)" : "")
                 << "\n";
     }

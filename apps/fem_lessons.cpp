@@ -8,6 +8,8 @@
 //              symmetric storage), and block Jacobi against scalar Jacobi in the PCG
 //   rotations  chapter 08: per element, the rotation by JacobiSVD and by Newton (cold and
 //              warm-started), the element blocks from a stored K0 and in closed form
+//   threads-element  chapter 09: the fused element pass in parallel by colouring and by
+//              per-node gather, on one thread and on all of them
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +17,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,11 +26,14 @@
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
+#include "chapters/09_threads/parallel.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "common/alloc_counter.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/model.hpp"
+#include "common/threads.hpp"
 
 namespace {
 
@@ -301,6 +307,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
   for (std::size_t e = 0; e < m; ++e)
     F[e] = deformation_gradient(model.rest[e], gather(state.x, model.tets[e]));
   const std::vector<Eigen::Quaterniond> previous = stepper.rotations();
+  const std::vector<Eigen::Quaterniond> before = stepper.previous_rotations();
   std::vector<Eigen::Quaterniond> q(m);
 
   const int repeat = std::max(5, steps);
@@ -317,7 +324,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       if (undecided > 0) s << " (" << undecided << " undecided)";
       return s.str();
     }
-  } count_cold, count_warm;
+  } count_cold, count_warm, count_predicted;
   const double svd = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(F[e]);
   });
@@ -338,9 +345,16 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       count_warm.add(ch08::newton_polar_rotation(F[e], q[e]));
     }
   });
+  const double predicted = to_ns * time_ms(repeat, [&] {
+    count_predicted = Count{};
+    for (std::size_t e = 0; e < m; ++e) {
+      q[e] = ch08::predicted_rotation(previous[e], before[e]);
+      count_predicted.add(ch08::newton_polar_rotation(F[e], q[e]));
+    }
+  });
   const double fast = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) {
-      q[e] = previous[e];
+      q[e] = ch08::predicted_rotation(previous[e], before[e]);
       R[e] = ch08::fast_polar_rotation(F[e], q[e], fallbacks);
     }
   });
@@ -379,6 +393,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
            << static_cast<long long>(steps) * static_cast<long long>(m);
   }
 
+  const auto mib = [m](std::size_t bytes) { return static_cast<double>(bytes * m) / (1 << 20); };
   const BuildInfo info = build_info();
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
@@ -392,16 +407,21 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       << std::setprecision(1) << "| Newton, warm (from the previous step's rotation) | " << warm
       << " | " << std::setprecision(2) << svd / warm << "x | " << count_warm.mean(m) << " |\n"
       << std::setprecision(1)
-      << "| warm Newton with the SVD fallback, as the stepper calls it (chapter 08) | " << fast
+      << "| Newton, warm (predicted from the last two steps' rotations) | " << predicted
+      << " | " << std::setprecision(2) << svd / predicted << "x | " << count_predicted.mean(m)
+      << " |\n"
+      << std::setprecision(1)
+      << "| predicted start, Newton, SVD fallback: the stepper's (chapter 08) | " << fast
       << " | " << std::setprecision(2) << svd / fast << "x | - |\n\n";
   out << std::setprecision(1)
-      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data read (bytes) |\n"
-      << "| --- | ---: | ---: | ---: |\n"
+      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data per element "
+         "(bytes) | rest data per step (MiB) |\n"
+      << "| --- | ---: | ---: | ---: | ---: |\n"
       << "| sixteen `-R K0_ab R^T` from the stored K0 (chapter 07) | " << stored << " | 1.00x | "
-      << sizeof(ElementRest) << " |\n"
-      << "| ten closed-form blocks from the shape gradients (chapter 08) | " << closed << " | "
-      << std::setprecision(2) << stored / closed << "x | " << sizeof(ch08::ElementShape)
-      << " |\n\n";
+      << sizeof(ElementRest) << " | " << std::setprecision(2) << mib(sizeof(ElementRest)) << " |\n"
+      << std::setprecision(1) << "| ten closed-form blocks from the shape gradients (chapter 08) | "
+      << closed << " | " << std::setprecision(2) << stored / closed << "x | "
+      << sizeof(ch08::ElementShape) << " | " << mib(sizeof(ch08::ElementShape)) << " |\n\n";
   out << std::setprecision(1) << "Step 21 of the " << bench_scene.name << " scene on "
       << std::filesystem::path(bench_scene.mesh.file).filename().string() << " ("
       << bench_scene.mesh.num_tets() << " tets); median of " << repeat
@@ -412,6 +432,90 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       << "`. Generated by `fem_lessons rotations`.\n";
   volatile double keep = sink.sum();
   (void)keep;
+  return out.str();
+}
+
+// The block SpMV of chapter 09's PCG (the rows in fixed chunks, a static schedule, a barrier
+// after each product) on the scene's system, at each thread count, in GB/s of what one
+// product must read at least: the blocks and their column indices.
+std::string threads_spmv_rows(const Scene& scene, const std::vector<int>& thread_counts) {
+  ch09::ThreadsStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  const ch09::BlockSparseMatrix& A = stepper.system_matrix();
+  const ch09::RowChunks chunks(A);
+  const Eigen::VectorXd x = Eigen::VectorXd::Ones(3 * A.block_rows());
+  Eigen::VectorXd y(x.size());
+  const int products = 100;
+  const double bytes = static_cast<double>(A.blocks.size()) * (sizeof(Eigen::Matrix3d) + sizeof(int));
+  std::ostringstream out;
+  out << std::fixed << "| block SpMV, " << A.blocks.size() << " blocks ("
+      << std::setprecision(2) << bytes / 1e6 << " MB) | threads | us per product | GB/s | speedup |\n"
+      << "| --- | ---: | ---: | ---: | ---: |\n";
+  double one = 0.0;
+  for (const int threads : thread_counts) {
+    const ThreadCountScope scope(threads);
+    const double us = 1e3 / products * time_ms(7, [&] {
+      ch09::run_parallel([&] {
+        for (int k = 0; k < products; ++k) {
+#pragma omp for schedule(static)
+          for (int c = 0; c < chunks.count(); ++c)
+            A.multiply_rows(x, y, chunks.start[c], chunks.start[c + 1]);
+        }
+      });
+    });
+    if (one == 0.0) one = us;
+    out << "| " << std::filesystem::path(scene.mesh.file).filename().string() << " | " << threads
+        << " | " << std::setprecision(1) << us << " | " << std::setprecision(1)
+        << bytes / (us * 1e3) << " | " << std::setprecision(2) << one / us << "x |\n";
+  }
+  return out.str();
+}
+
+// Chapter 09's two race-free element passes and chapter 08's serial one: the steppers run
+// interleaved, one step each in turn, and the fused element pass (the forces phase) is timed.
+std::string threads_element_table(const Scene& scene, int steps) {
+  struct Run {
+    std::string name;
+    int threads;
+    std::unique_ptr<Stepper> stepper;
+    State state;
+    std::vector<double> ms;
+  };
+  const int all = max_threads();
+  std::vector<Run> runs;
+  runs.push_back({"serial (chapter 08)", 1, make_stepper("08", scene), rest_state(scene), {}});
+  int colours = 0;
+  for (const auto& [name, how] : {std::pair{"colouring", ch09::ElementParallelism::colouring},
+                                  std::pair{"per-node gather", ch09::ElementParallelism::gather}})
+    for (const int threads : all > 1 ? std::vector<int>{1, all} : std::vector<int>{1}) {
+      auto stepper = std::make_unique<ch09::ThreadsStepper>(scene, SolverSettings{}, how);
+      colours = std::max(colours, stepper->colours());
+      runs.push_back({name, threads, std::move(stepper), rest_state(scene), {}});
+    }
+  for (int k = 0; k < steps + 2; ++k)
+    for (Run& run : runs) {
+      const ThreadCountScope threads(run.threads);
+      run.stepper->step(run.state);
+      if (k >= 2) run.ms.push_back(1e3 * run.stepper->profile().forces.seconds);  // set-up first
+    }
+  const double serial = median(runs.front().ms);
+  const BuildInfo info = build_info();
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(3)
+      << "| element pass | threads | median ms | vs chapter 08 |\n"
+      << "| --- | ---: | ---: | ---: |\n";
+  for (const Run& run : runs)
+    out << "| " << run.name << " | " << run.threads << " | " << median(run.ms) << " | "
+        << std::setprecision(2) << serial / median(run.ms) << "x |\n"
+        << std::setprecision(3);
+  out << "\n" << threads_spmv_rows(scene, all > 1 ? std::vector<int>{1, all} : std::vector<int>{1});
+  out << "\nThe fused element pass (rotations, forces, blocks into A and b), median of " << steps
+      << " steps of the " << scene.name << " scene on "
+      << std::filesystem::path(scene.mesh.file).filename().string() << " ("
+      << scene.mesh.num_tets() << " tets; " << colours << " colours of groups of 16 elements); "
+      << cpu_model() << ", " << info.compiler << ", `" << info.flags
+      << "`. Generated by `fem_lessons threads-element`.\n";
   return out.str();
 }
 
@@ -432,12 +536,13 @@ void write_between_markers(const std::string& path, const std::string& name,
 }
 
 const char* const kUsage =
-    "usage: fem_lessons [noalias|dfdx-fill|compose|spmv|rotations [options]]\n"
+    "usage: fem_lessons [noalias|dfdx-fill|compose|spmv|rotations|threads-element [options]]\n"
     "  noalias    allocations of each vector statement of chapter 01 and its chapter 02 rewrite\n"
     "  dfdx-fill  df/dx construction time: coeffRef, setFromTriplets, the offset table\n"
     "  compose    allocations of chapter 03's sparse sums, measured and predicted per cause\n"
     "  spmv       SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi\n"
     "  rotations  per element: rotation by SVD and by Newton; blocks from K0 and closed form\n"
+    "  threads-element  chapter 09's element pass: colouring against per-node gather\n"
     "without a lesson: every lesson in turn, with its defaults\n";
 
 // One lesson with its options (argv[0] is the lesson's name); returns the exit status.
@@ -448,8 +553,10 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
   args.option("steps", "N", "measured steps (dfdx-fill, rotations), solves (spmv; SpMV runs x20)",
               "50");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
+  add_thread_option(args);  // threads-element: the count beside one thread
   try {
     if (!args.parse(argc, argv)) return 0;
+    threads_from_args(args);
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
@@ -457,6 +564,7 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
                               : lesson == "dfdx-fill" ? dfdx_fill_table(scene, steps)
                               : lesson == "compose"   ? compose_table(scene)
                               : lesson == "rotations" ? rotations_table(scene, steps)
+                              : lesson == "threads-element" ? threads_element_table(scene, steps)
                                                       : spmv_table(scene, steps);
     std::cout << table;
     if (const std::string& readme = args.get("readme"); !readme.empty()) {
@@ -477,7 +585,7 @@ int run_lesson(const std::string& lesson, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   const std::vector<std::string> lessons = {"noalias", "dfdx-fill", "compose", "spmv",
-                                            "rotations"};
+                                            "rotations", "threads-element"};
   if (argc < 2) {  // every lesson, as the README of its chapter shows it
     for (const std::string& lesson : lessons) {
       std::cout << "\n## fem_lessons " << lesson << "\n\n" << std::flush;

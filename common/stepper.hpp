@@ -44,6 +44,9 @@ class Stepper {
   // Advances the state by one linearized backward Euler step of scene.dt.
   virtual void step(State& state) = 0;
   virtual const StepProfile& profile() const = 0;
+  // True for the chapters whose step runs on OpenMP's thread count (09 on); the others use
+  // one thread whatever it is. The benchmark measures the first kind at each count.
+  virtual bool uses_threads() const { return false; }
 
   // Replaces the sparse interaction forces from the next step on: the scene's own, or
   // the viewer's mouse spring. The storage is reused, so once it has held as many

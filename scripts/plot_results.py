@@ -3,6 +3,7 @@
 
     plot_results.py results/bench.json --out results       phases, speedup, allocations, solvers
     plot_results.py --scaling results/scaling.json --out results     scaling
+    plot_results.py --threads results/threads.json --out results     threads (thread scaling)
 """
 import argparse
 import pathlib
@@ -16,8 +17,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # noqa: E402
-                            POSTER_SOLVE_MS, ResultsError, chapter_color, comparable_to_poster,
-                            die, footer, load_checked, run_label)
+                            POSTER_SOLVE_MS, ResultsError, chapter_color, chapter_dir,
+                            comparable_to_poster, die, footer, load_checked, run_label)
 
 
 def finish(fig, data, path):
@@ -188,14 +189,64 @@ def plot_scaling(data, out):
     finish(fig, data, out / "scaling.png")
 
 
+def plot_threads(data, out):
+    """Step and solve time of the threaded chapters (rows NAME@N) against N, with the ideal
+    line t(1) / N and the chapter before them (one thread) as a horizontal reference."""
+    threaded = [c for c in data["chapters"] if "@" in c["chapter"]]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    if not threaded:
+        for ax in axes:
+            ax.text(0.5, 0.5, "no threaded chapter (NAME@N) in the results", ha="center", va="center")
+            ax.set_axis_off()
+        finish(fig, data, out / "threads.png")
+        return
+    counts = sorted({c["threads"] for c in threaded})
+    for key, ax, title in (("step", axes[0], "overall step"), ("solve", axes[1], "solve")):
+        for name in sorted({chapter_dir(c["chapter"]) for c in threaded}):
+            rows = sorted((c for c in threaded if chapter_dir(c["chapter"]) == name),
+                          key=lambda c: c["threads"])
+            xs = [c["threads"] for c in rows]
+            ys = [c["median_ms"][key] for c in rows]
+            lo = [c["median_ms"][key] - c["q1_ms"][key] for c in rows]
+            hi = [c["q3_ms"][key] - c["median_ms"][key] for c in rows]
+            line = ax.errorbar(xs, ys, yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], marker="o",
+                               capsize=3, label=f"{name} (median, quartiles)")
+            one = next((c["median_ms"][key] for c in rows if c["threads"] == 1), None)
+            if one is not None:
+                ax.plot(counts, [one / n for n in counts], ls="--", color=line[0].get_color(),
+                        alpha=0.6, label=f"{name} ideal: t(1) / threads")
+            for x, y in zip(xs, ys):
+                if one is not None:
+                    ax.annotate(f"x{one / y:.2f}", (x, y), textcoords="offset points", xytext=(6, 6),
+                                fontsize=8)
+        # The single-threaded chapter just before the first threaded one: what threads add to.
+        first = data["chapters"].index(threaded[0])
+        if first > 0:
+            ref = data["chapters"][first - 1]
+            ax.axhline(ref["median_ms"][key], color="0.5", lw=0.8, ls=":")
+            ax.annotate(f"{ref['chapter']} (one thread)", (counts[-1], ref["median_ms"][key]),
+                        fontsize=8, color="0.35", va="bottom", ha="right")
+        ax.set_xticks(counts)
+        ax.set_xlabel("threads")
+        ax.set_ylabel(f"median {title} time per step [ms]")
+        ax.set_ylim(bottom=0)
+        ax.set_title(f"{title.capitalize()} against threads")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"Thread scaling on a machine with {data['machine'].get('threads', '?')} hardware threads",
+                 fontsize=10)
+    finish(fig, data, out / "threads.png")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("bench", nargs="?", help="results/bench.json")
     parser.add_argument("--scaling", help="results/scaling.json")
+    parser.add_argument("--threads", help="results/threads.json (fem_bench --threads 1,2,...)")
     parser.add_argument("--out", default="results", help="directory for the PNG files")
     args = parser.parse_args()
-    if not args.bench and not args.scaling:
-        parser.error("give a bench.json, or --scaling scaling.json")
+    if not args.bench and not args.scaling and not args.threads:
+        parser.error("give a bench.json, or --scaling scaling.json, or --threads threads.json")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     try:
@@ -209,6 +260,8 @@ def main():
             plot_solvers(data, out)
         if args.scaling:
             plot_scaling(load_checked(args.scaling, scaling=True), out)
+        if args.threads:
+            plot_threads(load_checked(args.threads), out)
     except ResultsError as e:
         die(f"plot_results.py: {e}")
 

@@ -54,6 +54,11 @@ class ResultsError(Exception):
     pass
 
 
+def chapter_dir(name):
+    """The chapter directory of a result row: '09_threads@2' (chapter 09 on 2 threads) -> '09_threads'."""
+    return name.split("@")[0]
+
+
 def load(path):
     path = pathlib.Path(path)
     if not path.exists():
@@ -116,6 +121,9 @@ def validate_bench(data):
                 need(t, phase, float, f"{where}.{table}")
         for key in ("allocations_per_step", "cg_iterations", "relative_residual"):
             need(c, key, float, where)
+        if isinstance(c, dict) and "threads" in c and need(c, "threads", int, where) is not None \
+                and c["threads"] < 1:
+            problems.append(f"{where}.threads: expected >= 1, got {c['threads']}")
     for i, s in enumerate(data.get("solvers", [])):
         where = f"solvers[{i}]"
         need(s, "name", str, where)

@@ -7,6 +7,7 @@
 
 #include "apps/viewer/markers.hpp"
 #include "chapters/registry.hpp"
+#include "common/threads.hpp"
 
 namespace fem::viewer {
 
@@ -138,6 +139,9 @@ void draw_panel(const Session& session, double frames_per_second, PanelState& st
   ImGui::Text("%.1f frames/s   t = %.2f s   %lld steps", frames_per_second, session.time(),
               session.steps());
   chapter_list(session, state);
+  // Chapters before 09 use one thread whatever the count (--threads or OMP_NUM_THREADS).
+  ImGui::Text("threads: %d %s", session.uses_threads() ? max_threads() : 1,
+              session.uses_threads() ? "(OpenMP)" : "(this chapter is single-threaded)");
   ImGui::Separator();
   phase_bars(session);
   ImGui::Separator();

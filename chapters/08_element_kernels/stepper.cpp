@@ -194,7 +194,10 @@ ElementKernelsStepper::ElementKernelsStepper(const Scene& scene, const SolverSet
       lame_from_young_poisson(scene.material.youngs_modulus, scene.material.poisson_ratio);
   shapes_.reserve(model_.tets.size());
   for (const ElementRest& rest : model_.rest) shapes_.push_back(make_element_shape(rest, lame));
-  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());  // the rest shape
+  // The rest shape's, as a start: a stepper created on a deformed body (the viewer switching
+  // chapters) starts cold, and Newton or the SVD fallback finds the rotations.
+  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());
+  previous_rotations_ = rotations_;
 
   // The pattern, once: a block per pair of nodes that share a tetrahedron. Where each
   // element's 16 blocks sit, the diagonal blocks and the transposes are found once too.
@@ -253,7 +256,7 @@ void ElementKernelsStepper::start_system(const State& state) {
 
 void ElementKernelsStepper::element_pass(const State& state) {
   const double h = scene_.dt, beta = scene_.damping.beta;
-  const double c = h + beta;              // b's df/dx term acts on (h + beta) v
+  const double c = h + beta;                  // b's df/dx term acts on (h + beta) v
   const double stiffness = h * beta + h * h;  // A = ... - (h beta + h^2) df/dx
   long long fallbacks = 0;
   std::array<Eigen::Matrix3d, 10> K;
@@ -265,7 +268,11 @@ void ElementKernelsStepper::element_pass(const State& state) {
       Ds.col(i) = state.x.segment<3>(3 * t[i + 1]) - state.x.segment<3>(3 * t[0]);
       Dv.col(i) = state.v.segment<3>(3 * t[i + 1]) - state.v.segment<3>(3 * t[0]);
     }
-    const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, rotations_[e], fallbacks);
+    Eigen::Quaterniond q = predicted_rotation(rotations_[e], previous_rotations_[e]);
+    const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks);
+    // The first step has no angular velocity to extrapolate: the next starts from R itself.
+    previous_rotations_[e] = first_step_ ? q : rotations_[e];
+    rotations_[e] = q;
     const Eigen::Matrix<double, 3, 4> r = rotated_gradients(R, shape.Dm_inv);
 
     // b_a += h f_a + h df/dx_a ((h + beta) v) without K0: both are -V P r_a with the linear
@@ -286,6 +293,7 @@ void ElementKernelsStepper::element_pass(const State& state) {
       if (a != b) A_.blocks[block[4 * b + a]] += K[p].transpose();
     }
   }
+  first_step_ = false;
   last_step_fallbacks_ = fallbacks;
   total_fallbacks_ += fallbacks;
 }
@@ -389,14 +397,19 @@ PcgResult pcg_solve(const BlockSparseMatrix& A, const std::vector<int>& diagonal
     while (result.iterations < settings.max_iterations) {
       A.multiply(p, q);
       const double step = rho / p.dot(q);
+      // An overflowing system (an absurd E) stays finite through the closed-form kernels,
+      // where K0 overflowed at once; it overflows here instead. Stop before y does, with a
+      // residual that says so, rather than iterate on NaN up to the cap.
+      if (!std::isfinite(step)) {
+        residual_norm2 = std::numeric_limits<double>::quiet_NaN();
+        break;
+      }
       y += step * p;
       r -= step * q;
       filter(constraints, r);
       ++result.iterations;
       residual_norm2 = r.squaredNorm();
-      // A non-finite residual (an overflowed system) never recovers: stop at once and let
-      // divergence() report it, instead of running to the iteration cap on NaN.
-      if (residual_norm2 < threshold || !std::isfinite(residual_norm2)) break;
+      if (residual_norm2 < threshold) break;
       precondition(inverse_diagonal, r, s);
       filter(constraints, s);
       const double rho_old = rho;

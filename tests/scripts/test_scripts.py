@@ -68,7 +68,9 @@ def main():
         out = tmp / "plots"
         p = run(SCRIPTS / "plot_results.py", FIXTURE, "--scaling", scaling, "--out", out)
         check("plot_results.py exits 0", p.returncode == 0, p.stderr)
-        for png in ["phases", "speedup", "allocations", "solvers", "scaling"]:
+        p = run(SCRIPTS / "plot_results.py", "--threads", FIXTURE, "--out", out)
+        check("plot_results.py --threads exits 0", p.returncode == 0, p.stderr)
+        for png in ["phases", "speedup", "allocations", "solvers", "scaling", "threads"]:
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
                   f"{f} missing or small")
@@ -79,13 +81,15 @@ def main():
         # Tables: a copy of the docs with the markers, filled from the fixture.
         root = tmp / "repo"
         for rel in ["README.md", "docs/results.md", "chapters/01_naive/README.md",
-                    "chapters/02_noalias/README.md", "chapters/06_custom_pcg/README.md"]:
+                    "chapters/02_noalias/README.md", "chapters/06_custom_pcg/README.md",
+                    "chapters/09_threads/README.md"]:
             (root / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / rel, root / rel)
         data = root / "docs" / "data"  # where the JSON behind the committed docs lives
         data.mkdir(parents=True)
         shutil.copy(FIXTURE, data / "bench.json")
         shutil.copy(scaling, data / "scaling.json")
+        shutil.copy(FIXTURE, data / "threads.json")
         viewer = viewer_fixture(bench)
         (data / "viewer.json").write_text(json.dumps(viewer))
         p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
@@ -128,12 +132,24 @@ def main():
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
         check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
+        threaded = [c for c in bench["chapters"] if "@" in c["chapter"]]
+        chapter = (root / "chapters" / "09_threads" / "README.md").read_text()
+        check("chapter 09 tables filled: NAME@N rows and the thread table",
+              all(f"bench-table:{c['chapter']}:begin -->\n| median ms" in chapter for c in threaded) and
+              "threads-table:begin -->\n| median ms" in chapter and
+              all(update_docs.ms(c["median_ms"]["step"]) in chapter for c in threaded),
+              chapter[chapter.find("measured effect"):][:800])
+        check("README links NAME@N rows to the chapter's directory",
+              "[`09_threads@2`](chapters/09_threads/README.md)" in readme)
 
         # Schema: the fixture passes, broken copies fail.
         check("fixture matches the schema", validate_bench(bench) == [], str(validate_bench(bench)))
         broken = copy.deepcopy(bench)
         del broken["chapters"][0]["median_ms"]["solve"]
         check("a missing phase is caught", validate_bench(broken) != [])
+        broken = copy.deepcopy(bench)
+        broken["chapters"][-1]["threads"] = 0
+        check("a thread count below 1 is caught", validate_bench(broken) != [])
         broken = copy.deepcopy(bench)
         broken["cg_tolerance"] = "tight"
         check("a wrong type is caught", validate_bench(broken) != [])
