@@ -12,7 +12,8 @@ int main(int argc, char** argv) {
   ArgParser args("fem_sim", "Simulates a scene with one chapter's stepper and writes VTK frames.");
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
-  args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", chapters().back().id);
+  add_thread_option(args);
+  args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", latest_chapter().id);
   args.option("steps", "N", "number of time steps, > 0", "200");
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
   args.option("out", "DIR", "directory for the .vtu frames and the .pvd series", "out/sim");
@@ -30,12 +31,15 @@ int main(int argc, char** argv) {
     if (steps <= 0) throw UsageError("--steps must be positive");
     if (every < 0) throw UsageError("--every must be >= 0");
     const SolverSettings solver = solver_from_args(args);
+    const int threads = threads_from_args(args);
     const Scene scene = scene_from_args(args);
 
     std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
               << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
               << chapter.id << ", " << steps << " steps of " << scene.dt << " s\n";
     auto stepper = chapter.make(scene, solver);
+    std::cout << "threads: " << (stepper->uses_threads() ? threads : 1)
+              << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";
     State state = rest_state(scene);
     VtkSeries series(args.get("out"), scene.name);
     if (every > 0) series.write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);

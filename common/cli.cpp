@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/build_info.hpp"
+#include "common/threads.hpp"
 
 namespace fem {
 namespace {
@@ -182,6 +183,24 @@ SolverSettings solver_from_args(const ArgParser& args) {
   if (!(s.tolerance > 0.0 && s.tolerance < 1.0)) throw UsageError("--tol must lie in (0, 1)");
   if (s.max_iterations <= 0) throw UsageError("--max-iters must be positive");
   return s;
+}
+
+void add_thread_option(ArgParser& args) {
+  args.option("threads", "N",
+              "threads of the parallel chapters, 09 on (default: OMP_NUM_THREADS, else all " +
+                  std::to_string(hardware_threads()) + ")",
+              "");
+}
+
+int threads_from_args(const ArgParser& args) {
+  if (const std::string& value = args.get("threads"); !value.empty()) {
+    try {
+      set_threads(args.get_int("threads"));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--threads: ") + e.what());
+    }
+  }
+  return max_threads();
 }
 
 }  // namespace fem

@@ -53,6 +53,13 @@ Scene scene_from_args(const ArgParser& args);
 void add_solver_options(ArgParser& args);
 SolverSettings solver_from_args(const ArgParser& args);
 
+// --threads N: the thread count of the parallel chapters (09 on). Without it OpenMP's own
+// rule holds: OMP_NUM_THREADS, or every hardware thread.
+void add_thread_option(ArgParser& args);
+// Applies --threads when given; returns the thread count in use. Throws UsageError for a
+// count below 1, or above 1 in a build without OpenMP.
+int threads_from_args(const ArgParser& args);
+
 // A relative mesh path is looked up from the working directory, then from the repository.
 std::string resolve_mesh_path(const std::string& path);
 

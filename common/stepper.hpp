@@ -44,6 +44,9 @@ class Stepper {
   // Advances the state by one linearized backward Euler step of scene.dt.
   virtual void step(State& state) = 0;
   virtual const StepProfile& profile() const = 0;
+  // True for the chapters whose step runs on OpenMP's thread count (09 on); the others use
+  // one thread whatever it is. The benchmark measures the first kind at each count.
+  virtual bool uses_threads() const { return false; }
 
   // Replaces the sparse interaction forces from the next step on: the scene's own, or
   // the viewer's mouse spring. The storage is reused, so once it has held as many
@@ -92,9 +95,11 @@ void report_if_not_converged(const StepProfile& profile, const SolverSettings& s
                              const char* chapter, bool& already_warned);
 
 // Why the last step cannot be trusted, or nullptr when it can: non-finite positions or
-// velocities, or a solve whose residual is not finite. The second happens when the system
+// velocities, a solve whose residual is not finite, or a solve stopped at the iteration cap
+// with a relative residual above 1 (worse than dv = 0). The second happens when the system
 // overflows (an absurd E or dt): CG then stops at once and leaves the state finite but
-// frozen, which a check of the positions alone would let pass silently.
+// frozen, which a check of the positions alone would let pass silently. The third happens
+// with a near-incompressible material (nu = 0.4999999): every step ran to the cap, finite.
 const char* divergence(const State& state, const StepProfile& profile);
 
 }  // namespace fem

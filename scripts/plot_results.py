@@ -3,6 +3,7 @@
 
     plot_results.py results/bench.json --out results       phases, speedup, allocations, solvers
     plot_results.py --scaling results/scaling.json --out results     scaling
+    plot_results.py --threads results/threads.json --out results     threads (thread scaling)
 """
 import argparse
 import pathlib
@@ -16,7 +17,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # noqa: E402
-                            POSTER_SOLVE_MS, ResultsError, die, footer, load_checked)
+                            POSTER_SOLVE_MS, ResultsError, chapter_color, chapter_dir,
+                            comparable_to_poster, die, footer, load_checked, run_label)
 
 
 def finish(fig, data, path):
@@ -31,6 +33,10 @@ def chapter_labels(chapters):
     return [c["chapter"] for c in chapters]
 
 
+def color(c):
+    return chapter_color(c["chapter"], c.get("variant_of", ""))
+
+
 def plot_phases(data, out):
     chapters = data["chapters"]
     phases = ["forces"] + PHASES
@@ -42,11 +48,12 @@ def plot_phases(data, out):
         lo = med - np.array([c["q1_ms"][p] for p in phases])
         hi = np.array([c["q3_ms"][p] for p in phases]) - med
         ax.bar(x + (i - (len(chapters) - 1) / 2) * width, np.maximum(med, 1e-4), width,
-               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"])
+               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"],
+               color=color(c))
     ax.set_yscale("log")
     ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel("median time per step [ms] (log; bars: quartiles)")
-    ax.set_title("Time per phase of one step, chapter by chapter")
+    ax.set_title(f"Time per phase of one step, chapter by chapter ({run_label(data)})")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "phases.png")
@@ -60,23 +67,32 @@ def plot_speedup(data, out):
         ax.text(0.5, 0.5, "only one chapter measured: no speedup to show" if base else
                 f"no {BASELINE} in the results: no baseline", ha="center", va="center")
         ax.set_axis_off()
-        ax.set_title("Speedup over chapter 01")
+        ax.set_title(f"Speedup over chapter 01 ({run_label(data)})")
         finish(fig, data, out / "speedup.png")
         return
     others = [c for c in chapters if c is not base]
-    x = np.arange(len(PHASES))
-    width = 0.8 / (len(others) + 1)
+    # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
+    phases = ["forces"] + PHASES
+    poster = comparable_to_poster(data)
+    bars = len(others) + (1 if poster else 0)
+    x = np.arange(len(phases))
+    width = 0.8 / bars
     for i, c in enumerate(others):
-        s = [base["median_ms"][p] / max(c["median_ms"][p], 1e-9) for p in PHASES]
-        ax.bar(x + (i - len(others) / 2) * width, s, width, label=c["chapter"])
-    poster = [POSTER_SPEEDUPS.get(p, np.nan) for p in PHASES]
-    ax.bar(x + (len(others) - len(others) / 2) * width, poster, width, color="none",
-           edgecolor="black", hatch="//", label="poster (optimized vs naive)")
+        # A phase a chapter no longer has (chapter 08's df/dx, fused into its element pass) gets
+        # no bar rather than an infinite one.
+        s = [base["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
+             for p in phases]
+        ax.bar(x + (i - (bars - 1) / 2) * width, s, width, label=c["chapter"], color=color(c))
+    if poster:
+        ax.bar(x + (len(others) - (bars - 1) / 2) * width,
+               [POSTER_SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
+               edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
-    ax.set_xticks(x, [PHASE_LABELS[p] for p in PHASES])
+    ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
-    ax.set_title("Speedup per phase over the naive stepper, beside the poster's")
+    ax.set_title("Speedup per phase over the naive stepper" + (", beside the poster's" if poster else "")
+                 + f" ({run_label(data)})")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "speedup.png")
@@ -86,14 +102,15 @@ def plot_allocations(data, out):
     chapters = data["chapters"]
     counts = [c["allocations_per_step"] for c in chapters]
     fig, ax = plt.subplots(figsize=(9, 4.5))
-    bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts], color="tab:red")
+    bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts],
+                  color=[color(c) for c in chapters])
     for bar, a in zip(bars, counts):
         ax.annotate(f"{a:g}", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
                     ha="center", va="bottom", fontsize=9)
     ax.set_yscale("log")
     ax.set_ylim(0.3, max(counts + [1]) * 3)
     ax.set_ylabel("heap allocations per step (log; 0 drawn at 0.5)")
-    ax.set_title("Heap allocations per step (after the first)")
+    ax.set_title(f"Heap allocations per step, after the first ({run_label(data)})")
     ax.tick_params(axis="x", rotation=20)
     finish(fig, data, out / "allocations.png")
 
@@ -104,19 +121,26 @@ def plot_solvers(data, out):
         return
     names = [s["name"] for s in solvers]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
-    ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
-    poster = [POSTER_SOLVE_MS.get(n) for n in names]
-    ys = [i for i, p in enumerate(poster) if p is not None]
-    ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
+    if all("setup_ms" in s and "solve_ms" in s for s in solvers):
+        setup = [s["setup_ms"] for s in solvers]
+        ax1.barh(names, setup, color="tab:orange", label="setup: compute() / factorize()")
+        ax1.barh(names, [s["solve_ms"] for s in solvers], left=setup, color="tab:blue",
+                 label="solve")
+    else:
+        ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
+    if comparable_to_poster(data):  # absolute times compare only on the poster's run
+        poster = [POSTER_SOLVE_MS.get(n) for n in names]
+        ys = [i for i, p in enumerate(poster) if p is not None]
+        ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
+    ax1.legend(fontsize=8)
     ax1.invert_yaxis()
     ax1.set_xlabel("median time per solve [ms]")
     ax1.set_title("Time per solve")
-    ax1.legend(fontsize=8)
     ax2.barh(names, [s["iterations"] for s in solvers], color="tab:green")
     ax2.invert_yaxis()
     ax2.set_xlabel("CG iterations per solve (median; 0 for a direct solver)")
     ax2.set_title("Iterations")
-    fig.suptitle("The solve table: the same systems, the same tolerance")
+    fig.suptitle(f"The solve table: the same systems, the same tolerance ({run_label(data)})")
     finish(fig, data, out / "solvers.png")
 
 
@@ -144,7 +168,7 @@ def plot_scaling(data, out):
         for c in chapters:
             pts = sorted((r["nodes"], r[key]) for r in runs if r["chapter"] == c)
             xs, ys = zip(*pts)
-            line, = ax.plot(xs, ys, marker="o", ms=3)
+            line, = ax.plot(xs, ys, marker="o", ms=3, color=chapter_color(c))
             if c in stopped:
                 ax.scatter([xs[-1]], [ys[-1]], marker="x", s=70, color=line.get_color(), zorder=3)
             ends.append((xs[-1], ys[-1], c + (" (stopped)" if c in stopped else ""), line.get_color()))
@@ -160,30 +184,84 @@ def plot_scaling(data, out):
         ax.set_ylabel(f"median {title} time per step [ms] (log)")
         ax.set_title(f"{title.capitalize()} against mesh size")
         ax.grid(which="both", alpha=0.3)
-    fig.suptitle(f"Scaling over the beam series (x: the next size went over the "
+    fig.suptitle(f"Scaling over the beam series, {data['scene']} scene (x: the next size went over the "
                  f"{data.get('budget_seconds', '?')} s budget per run)", fontsize=10)
     finish(fig, data, out / "scaling.png")
+
+
+def plot_threads(data, out):
+    """Step and solve time of the threaded chapters (rows NAME@N) against N, with the ideal
+    line t(1) / N and the chapter before them (one thread) as a horizontal reference."""
+    threaded = [c for c in data["chapters"] if "@" in c["chapter"]]
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    if not threaded:
+        for ax in axes:
+            ax.text(0.5, 0.5, "no threaded chapter (NAME@N) in the results", ha="center", va="center")
+            ax.set_axis_off()
+        finish(fig, data, out / "threads.png")
+        return
+    counts = sorted({c["threads"] for c in threaded})
+    for key, ax, title in (("step", axes[0], "overall step"), ("solve", axes[1], "solve")):
+        for name in sorted({chapter_dir(c["chapter"]) for c in threaded}):
+            rows = sorted((c for c in threaded if chapter_dir(c["chapter"]) == name),
+                          key=lambda c: c["threads"])
+            xs = [c["threads"] for c in rows]
+            ys = [c["median_ms"][key] for c in rows]
+            lo = [c["median_ms"][key] - c["q1_ms"][key] for c in rows]
+            hi = [c["q3_ms"][key] - c["median_ms"][key] for c in rows]
+            line = ax.errorbar(xs, ys, yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], marker="o",
+                               capsize=3, label=f"{name} (median, quartiles)")
+            one = next((c["median_ms"][key] for c in rows if c["threads"] == 1), None)
+            if one is not None:
+                ax.plot(counts, [one / n for n in counts], ls="--", color=line[0].get_color(),
+                        alpha=0.6, label=f"{name} ideal: t(1) / threads")
+            for x, y in zip(xs, ys):
+                if one is not None:
+                    ax.annotate(f"x{one / y:.2f}", (x, y), textcoords="offset points", xytext=(6, 6),
+                                fontsize=8)
+        # The single-threaded chapter just before the first threaded one: what threads add to.
+        first = data["chapters"].index(threaded[0])
+        if first > 0:
+            ref = data["chapters"][first - 1]
+            ax.axhline(ref["median_ms"][key], color="0.5", lw=0.8, ls=":")
+            ax.annotate(f"{ref['chapter']} (one thread)", (counts[-1], ref["median_ms"][key]),
+                        fontsize=8, color="0.35", va="bottom", ha="right")
+        ax.set_xticks(counts)
+        ax.set_xlabel("threads")
+        ax.set_ylabel(f"median {title} time per step [ms]")
+        ax.set_ylim(bottom=0)
+        ax.set_title(f"{title.capitalize()} against threads")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"Thread scaling on a machine with {data['machine'].get('threads', '?')} hardware threads",
+                 fontsize=10)
+    finish(fig, data, out / "threads.png")
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("bench", nargs="?", help="results/bench.json")
     parser.add_argument("--scaling", help="results/scaling.json")
+    parser.add_argument("--threads", help="results/threads.json (fem_bench --threads 1,2,...)")
     parser.add_argument("--out", default="results", help="directory for the PNG files")
     args = parser.parse_args()
-    if not args.bench and not args.scaling:
-        parser.error("give a bench.json, or --scaling scaling.json")
+    if not args.bench and not args.scaling and not args.threads:
+        parser.error("give a bench.json, or --scaling scaling.json, or --threads threads.json")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     try:
         if args.bench:
             data = load_checked(args.bench)
+            print(f"plots of {args.bench}: {run_label(data)}, "
+                  f"{', '.join(c['chapter'] for c in data['chapters'])}")
             plot_phases(data, out)
             plot_speedup(data, out)
             plot_allocations(data, out)
             plot_solvers(data, out)
         if args.scaling:
             plot_scaling(load_checked(args.scaling, scaling=True), out)
+        if args.threads:
+            plot_threads(load_checked(args.threads), out)
     except ResultsError as e:
         die(f"plot_results.py: {e}")
 

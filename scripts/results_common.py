@@ -7,7 +7,9 @@ import sys
 PHASES = ["dfdx", "compose", "constraints", "solve", "step"]
 ALL_PHASES = ["forces"] + PHASES
 PHASE_LABELS = {
-    "forces": "forces (shared)",
+    # common/'s element kernels in chapters 01-07; chapter 08's fused element pass, which
+    # also does the work of df/dx construction and most of the composition (its dfdx is 0)
+    "forces": "forces",
     "dfdx": "df/dx construction",
     "compose": "system composition",
     "constraints": "constraints",
@@ -19,10 +21,42 @@ PHASE_LABELS = {
 POSTER_SPEEDUPS = {"dfdx": 5.487, "compose": 21.358, "constraints": 218.79, "step": 9.849}
 POSTER_SOLVE_MS = {"eigen_cg": 7.1, "eigen_cg_guess": 4.39, "pcg_ch06": 1.68}
 BASELINE = "01_naive"
+# The poster's numbers were measured on the cantilever on a mesh of the poster's size: they
+# are drawn beside a run only when the run is that one (any other mesh or scene would compare
+# unlike with unlike).
+POSTER_MESH, POSTER_SCENE = "plate_poster.msh", "cantilever"
+
+
+def comparable_to_poster(data):
+    return data.get("mesh", {}).get("file") == POSTER_MESH and data.get("scene") == POSTER_SCENE
+
+
+def run_label(data):
+    """What a plot's title says about the run: the scene and the mesh."""
+    mesh = data.get("mesh")
+    where = f"{mesh['file']}, {mesh['nodes']} nodes" if mesh else "the beam series"
+    return f"{data['scene']} scene, {where}"
+
+
+def chapter_color(chapter, variant_of=""):
+    """One colour per chapter in every plot: matplotlib's tab20 pairs, the dark one for the
+    chapter NN of the course, the light one of the same hue for a student's variant of it."""
+    import matplotlib
+    palette = matplotlib.colormaps["tab20"].colors
+    try:
+        number = int(chapter[:2])
+    except ValueError:
+        return "0.4"
+    return palette[(2 * (number - 1)) % 20 + (1 if variant_of else 0)]
 
 
 class ResultsError(Exception):
     pass
+
+
+def chapter_dir(name):
+    """The chapter directory of a result row: '09_threads@2' (chapter 09 on 2 threads) -> '09_threads'."""
+    return name.split("@")[0]
 
 
 def load(path):
@@ -87,11 +121,17 @@ def validate_bench(data):
                 need(t, phase, float, f"{where}.{table}")
         for key in ("allocations_per_step", "cg_iterations", "relative_residual"):
             need(c, key, float, where)
+        if isinstance(c, dict) and "threads" in c and need(c, "threads", int, where) is not None \
+                and c["threads"] < 1:
+            problems.append(f"{where}.threads: expected >= 1, got {c['threads']}")
     for i, s in enumerate(data.get("solvers", [])):
         where = f"solvers[{i}]"
         need(s, "name", str, where)
         for key in ("median_ms", "iterations", "allocations_per_solve"):
             need(s, key, float, where)
+        for key in ("setup_ms", "solve_ms"):  # absent in results written before they existed
+            if isinstance(s, dict) and key in s:
+                need(s, key, float, where)
     return problems
 
 

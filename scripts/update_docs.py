@@ -5,10 +5,19 @@ comments (never typed by hand):
   docs/results.md          results:machine, results:phases, results:speedups,
                            results:allocations, results:solvers, results:scaling
   README.md                headline, chapter-map, viewer-fps (from results/viewer.json)
+  regime sweep             regimes:poster, regimes:points, regimes:solvers in docs/results.md and
+                           regimes:poster in README.md (from results/regimes.json, copied to
+                           docs/data/regimes.json; without it, from docs/data/regimes.json)
   chapters/NN_*/README.md  bench-table:<chapter>, and results:solvers where present
 
-    .venv/bin/python scripts/update_docs.py                  # from results/bench.json
+The JSON behind the committed docs is committed too, in docs/data/ (bench.json, and
+scaling.json and viewer.json when they were run): `./tutorial.sh docs` copies a new run there
+first. --check writes nothing and fails when a generated section differs from what the
+committed JSON gives (ctest label docs).
+
+    .venv/bin/python scripts/update_docs.py                  # from docs/data/bench.json
     .venv/bin/python scripts/update_docs.py --images docs/images   # also copy the plots
+    .venv/bin/python scripts/update_docs.py --check          # are the docs those of docs/data?
 """
 import argparse
 import pathlib
@@ -18,7 +27,9 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (ALL_PHASES, BASELINE, PHASE_LABELS, PHASES, POSTER_SOLVE_MS,  # noqa: E402
-                            POSTER_SPEEDUPS, ResultsError, die, load_checked)
+                            POSTER_SPEEDUPS, ResultsError, chapter_dir, die, load_checked)
+import regimes_common  # noqa: E402
+from results_common import load  # noqa: E402
 
 
 def ms(x):
@@ -96,11 +107,12 @@ def solvers_table(data):
     rows = []
     for s in solvers:
         poster = POSTER_SOLVE_MS.get(s["name"])
-        rows.append([f"`{s['name']}`", ms(s["median_ms"]), ratio(base, s["median_ms"]),
+        split = [ms(s[k]) if k in s else "-" for k in ("setup_ms", "solve_ms")]
+        rows.append([f"`{s['name']}`", ms(s["median_ms"])] + split + [ratio(base, s["median_ms"]),
                      f"{s['iterations']:g}", f"{s['allocations_per_solve']:g}",
                      f"{poster:g} ms (x{POSTER_SOLVE_MS['eigen_cg'] / poster:.3g})" if poster else "-"])
-    return table(["solver", "median ms", f"vs `{solvers[0]['name']}`", "iterations",
-                  "allocations per solve", "poster"], rows)
+    return table(["solver", "median ms", "setup ms", "solve ms", f"vs `{solvers[0]['name']}`",
+                  "iterations", "allocations per solve", "poster"], rows)
 
 
 def scaling_table(scaling):
@@ -134,7 +146,7 @@ def headline(data):
     base = by.get(BASELINE)
     rows = []
     for c in data["chapters"]:
-        rows.append([f"[`{c['chapter']}`](chapters/{c['chapter']}/README.md)", ms(c["median_ms"]["step"]),
+        rows.append([f"[`{c['chapter']}`](chapters/{chapter_dir(c['chapter'])}/README.md)", ms(c["median_ms"]["step"]),
                      ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-",
                      f"{c['allocations_per_step']:g}"])
     mesh, b = data["mesh"], data["build"]
@@ -153,12 +165,20 @@ def chapter_map(data):
     for c in data["chapters"]:
         name = c["chapter"]
         moved = "the baseline"
-        if previous is not None:
+        if previous is not None and c["median_ms"]["dfdx"] == 0 < previous["median_ms"]["dfdx"]:
+            # A fused element pass (chapter 08) has no df/dx phase of its own: compare the three
+            # phases it replaces together, not a zero.
+            fused = ("forces", "dfdx", "compose")
+            moved = (f"forces + df/dx + composition (fused) "
+                     f"{ratio(sum(previous['median_ms'][p] for p in fused), sum(c['median_ms'][p] for p in fused))} "
+                     f"over `{previous['chapter']}`")
+        elif previous is not None:
             phase = max(PHASES[:-1], key=lambda p: previous["median_ms"][p] / max(c["median_ms"][p], 1e-9))
             moved = (f"{PHASE_LABELS[phase]} {ratio(previous['median_ms'][phase], c['median_ms'][phase])} "
                      f"over `{previous['chapter']}`")
-        diff = f"[diff](docs/diffs/{name}.diff)" if previous is not None else ""
-        rows.append([f"[`{name}`](chapters/{name}/README.md)", c.get("title", ""), moved,
+        diff = f"[diff](docs/diffs/{chapter_dir(name)}.diff)" if previous is not None and \
+            chapter_dir(previous["chapter"]) != chapter_dir(name) else ""
+        rows.append([f"[`{name}`](chapters/{chapter_dir(name)}/README.md)", c.get("title", ""), moved,
                      ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-", diff])
         previous = c
     return table(["chapter", "the idea", "the phase it moves most", "step speedup over 01", "diff"],
@@ -174,14 +194,123 @@ def chapter_table(data, name):
     shown = [x for i, x in enumerate(shown) if x not in shown[:i]]
     rows = [[f"`{x['chapter']}`"] + [ms(x["median_ms"][p]) for p in ALL_PHASES] +
             [f"{x['allocations_per_step']:g}", f"{x['cg_iterations']:g}"] for x in shown]
-    for ref in (by.get(BASELINE), previous):
-        if ref is not None and ref is not c:
+    refs = [r for r in (by.get(BASELINE), previous) if r is not None and r is not c]
+    for ref in [r for i, r in enumerate(refs) if r not in refs[:i]]:  # 02: previous is 01
             rows.append([f"speedup over `{ref['chapter']}`"] +
                         [ratio(ref["median_ms"][p], c["median_ms"][p]) for p in ALL_PHASES] + ["", ""])
     header = ["median ms"] + [PHASE_LABELS[p] for p in ALL_PHASES] + ["allocations/step", "CG it."]
+    fused_note = ""
+    if previous is not None and c["median_ms"]["dfdx"] == 0 < previous["median_ms"]["dfdx"]:
+        # A fused element pass has no df/dx phase: the three phases it replaces, summed.
+        fused = lambda x: sum(x["median_ms"][p] for p in ("forces", "dfdx", "compose"))  # noqa: E731
+        fused_note = (f" Forces + df/dx construction + system composition, the work of the fused "
+                      f"element pass: {ms(fused(previous))} ms in `{previous['chapter']}`, "
+                      f"{ms(fused(c))} ms in `{c['chapter']}` ({ratio(fused(previous), fused(c))}).")
     return (table(header, rows) +
             f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; machine and flags in "
-            f"[docs/results.md](../../docs/results.md). Generated by `scripts/update_docs.py`.\n")
+            f"[docs/results.md](../../docs/results.md).{fused_note} Generated by `scripts/update_docs.py`.\n")
+
+
+def regimes_points_table(reg):
+    """One row per point of the regime sweep: chapter 01's CG iterations and solve share, the
+    overall step's speedup of every chapter over 01, and the solve table's two poster ratios."""
+    names = [n for n in regimes_common.chapter_names(reg) if n != BASELINE]
+    rows = []
+    for body in reg["bodies"]:
+        for p in regimes_common.body_points(reg, body):
+            ratios = [regimes_common.solver_ratio(p, k) for k in ("eigen_cg_guess", "pcg_ch06")]
+            rows.append([f"`{body}`", f"{p['E']:g}", f"{regimes_common.iterations(p):g}",
+                         f"{100 * regimes_common.share(p, 'solve'):.0f}%", ms(p["chapters"][0]["median_ms"]["step"])] +
+                        [f"x{regimes_common.speedup(p, n):.2f}" for n in names] +
+                        [f"x{r:.2f}" if r else "-" for r in ratios])
+    return table(["body", "E (Pa)", "01's CG it.", "solve share of 01's step", "01's step (ms)"] +
+                 [f"`{n[:2]}`" for n in names] + ["`solveWithGuess()`", "our PCG"], rows,
+                 ["---"] + ["---:"] * (len(names) + 6))
+
+
+def regimes_solvers_table(reg):
+    """The whole solve table at the softest and the stiffest point of each body."""
+    shown = []
+    for body in reg["bodies"]:
+        pts = regimes_common.body_points(reg, body)
+        shown += [pts[0], pts[-1]] if len(pts) > 1 else pts
+    if not all(p.get("solvers") for p in shown):
+        return "(the sweep ran with --no-solvers)\n"
+    names = [s["name"] for s in shown[0]["solvers"]]
+    rows = []
+    for n in names:
+        cells = []
+        for p in shown:
+            s = next(x for x in p["solvers"] if x["name"] == n)
+            cells.append(f"{ms(s['median_ms'])} ({ratio(p['solvers'][0]['median_ms'], s['median_ms'])}, "
+                         f"{s['iterations']:g} it., {s['allocations_per_solve']:g} alloc.)")
+        poster = POSTER_SOLVE_MS.get(n)
+        rows.append([f"`{n}`"] + cells + [f"{poster:g} ms" if poster else "-"])
+    header = [f"`{p['body']}`, E = {p['E']:g} (01: {regimes_common.iterations(p):g} it.)" for p in shown]
+    ends = "; ".join(
+        f"`{body}`: x{regimes_common.solver_ratio(pts[0], 'pcg_ch06'):.2f} at the softest point, "
+        f"x{regimes_common.solver_ratio(pts[-1], 'pcg_ch06'):.2f} at the stiffest"
+        for body, pts in ((b, regimes_common.body_points(reg, b)) for b in reg["bodies"]))
+    return (table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows) +
+            f"\nOur PCG over Eigen's `solve()` (poster x4.226): {ends}.\n")
+
+
+def update_regimes(root, path, images, stale=None):
+    """The regime sweep's generated sections (results/regimes.json, kept as docs/data/regimes.json,
+    the JSON behind the committed docs): without a sweep, the committed sections stay."""
+    data_copy = root / "docs" / "data" / "regimes.json"
+    source = path or root / "results" / "regimes.json"
+    if not source.exists():
+        if path is not None or not data_copy.exists():
+            print(f"no {source}: the regime sections stay as they are (./tutorial.sh regimes)")
+            return
+        source = data_copy
+    try:
+        reg = load(source)
+    except ResultsError as e:
+        die(f"update_docs.py: {e}")
+    problems = regimes_common.validate_regimes(reg)
+    if problems:
+        die(f"update_docs.py: {source} does not match the regimes schema:\n  " + "\n  ".join(problems))
+    if source.resolve() != data_copy.resolve() and stale is None:
+        data_copy.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(source, data_copy)
+        print(f"copied {source.name} to {data_copy.parent}")
+    poster = regimes_common.poster_statements(reg)
+    update_file(root / "docs" / "results.md", {"regimes:poster": poster,
+                                               "regimes:points": regimes_points_table(reg),
+                                               "regimes:solvers": regimes_solvers_table(reg)},
+                stale)
+    update_file(root / "README.md", {"regimes:poster": poster}, stale)
+    if stale is not None:
+        return
+    png = source.with_name("regimes.png")
+    if images and png.exists() and source != data_copy:
+        images = images if images.is_absolute() else root / images
+        images.mkdir(parents=True, exist_ok=True)
+        shutil.copy(png, images / png.name)
+        print(f"copied {png.name} to {images}")
+
+
+def threads_table(threads):
+    """Chapter 09 per thread count (docs/data/threads.json, from ./tutorial.sh threads): every
+    phase, and the speedup of each over the same chapter on one thread."""
+    rows = []
+    for c in threads["chapters"]:
+        one = next((x for x in threads["chapters"] if chapter_dir(x["chapter"]) == chapter_dir(c["chapter"])
+                    and x.get("threads", 1) == 1), c)
+        rows.append([f"`{c['chapter']}`"] + [ms(c["median_ms"][p]) for p in ALL_PHASES] +
+                    [ratio(one["median_ms"]["solve"], c["median_ms"]["solve"]),
+                     ratio(one["median_ms"]["step"], c["median_ms"]["step"])])
+    header = (["median ms"] + [PHASE_LABELS[p] for p in ALL_PHASES] +
+              ["solve vs 1 thread", "step vs 1 thread"])
+    b, m = threads["build"], threads["machine"]
+    return (table(header, rows) +
+            f"\n{threads['mesh']['file']}, {threads['scene']}, {threads['steps']} steps, one interleaved run "
+            f"(`./tutorial.sh threads`) on {m['cpu']} with {m.get('threads', '?')} hardware threads"
+            + (f" (1-minute load average {m['load_average'][0]:.1f} at the start, "
+               f"{m['load_average'][1]:.1f} at the end)" if "load_average" in m else "") + ", "
+            f"{b['compiler']} `{b['flags']}`, commit {threads['commit']}. Generated by `scripts/update_docs.py`.\n")
 
 
 def replace(text, name, body):
@@ -193,17 +322,25 @@ def replace(text, name, body):
     return pattern.sub(lambda _: begin + "\n" + body + end, text), True
 
 
-def update_file(path, sections):
+def update_file(path, sections, stale=None):
+    """Writes the sections into path; with a list `stale`, writes nothing and appends to it
+    the sections whose committed text differs."""
     if not path.exists():
         print(f"note: {path} is missing, skipped")
         return
-    text = path.read_text()
+    original = text = path.read_text()
     done = []
     for name, body in sections.items():
+        before = text
         text, found = replace(text, name, body)
         if found:
             done.append(name)
-    path.write_text(text)
+            if stale is not None and text != before:
+                stale.append(f"{path}: {name}")
+    if stale is not None:
+        return
+    if text != original:
+        path.write_text(text)
     if done:
         print(f"updated {path}: {', '.join(done)}")
 
@@ -212,20 +349,33 @@ def main():
     root_default = pathlib.Path(__file__).resolve().parent.parent
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--root", type=pathlib.Path, default=root_default, help="repository root")
-    parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/results/bench.json")
-    parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/results/scaling.json if present")
-    parser.add_argument("--viewer", type=pathlib.Path, help="default: ROOT/results/viewer.json if present")
+    parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/docs/data/bench.json")
+    parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/docs/data/scaling.json if present")
+    parser.add_argument("--viewer", type=pathlib.Path, help="default: ROOT/docs/data/viewer.json if present")
+    parser.add_argument("--threads", type=pathlib.Path, help="default: ROOT/docs/data/threads.json if present")
+    parser.add_argument("--regimes", type=pathlib.Path,
+                        help="default: ROOT/results/regimes.json, else ROOT/docs/data/regimes.json")
+    parser.add_argument("--check", action="store_true",
+                        help="write nothing; exit 1 if a generated section differs from the JSON")
     parser.add_argument("--images", type=pathlib.Path, nargs="?", const=pathlib.Path("docs/images"),
                         help="copy the PNG plots from the results directory here (default docs/images)")
+    parser.add_argument("--only-regimes", action="store_true",
+                        help="only the regime sweep's sections (no results/bench.json needed)")
     args = parser.parse_args()
     root = args.root
-    bench_path = args.bench or root / "results" / "bench.json"
-    scaling_path = args.scaling or root / "results" / "scaling.json"
+    if args.only_regimes:
+        update_regimes(root, args.regimes, args.images)
+        return
+    data_dir = root / "docs" / "data"
+    bench_path = args.bench or data_dir / "bench.json"
+    scaling_path = args.scaling or data_dir / "scaling.json"
     try:
         data = load_checked(bench_path)
         scaling = load_checked(scaling_path, scaling=True) if scaling_path.exists() else None
-        viewer_path = args.viewer or root / "results" / "viewer.json"
+        viewer_path = args.viewer or data_dir / "viewer.json"
         viewer = load_checked(viewer_path, viewer=True) if viewer_path.exists() else None
+        threads_path = args.threads or data_dir / "threads.json"
+        threads = load_checked(threads_path) if threads_path.exists() else None
     except ResultsError as e:
         die(f"update_docs.py: {e}")
 
@@ -238,23 +388,39 @@ def main():
     # committed table stays as it is (a placeholder goes in only where there is no table yet).
     if scaling is not None or "run `./tutorial.sh scaling`" in (root / "docs" / "results.md").read_text():
         tables["results:scaling"] = scaling_table(scaling)
-    else:
-        print("no results/scaling.json: the scaling table in docs/results.md is left as it is")
-    update_file(root / "docs" / "results.md", tables)
+    elif not args.check:
+        print(f"no {scaling_path}: the scaling table in docs/results.md is left as it is")
+    stale = [] if args.check else None
+    update_file(root / "docs" / "results.md", tables, stale)
     readme = {"headline": headline(data), "chapter-map": chapter_map(data)}
     if viewer is not None:  # like the scaling table: optional, kept as it is without a new run
         readme["viewer-fps"] = viewer_table(viewer)
-    update_file(root / "README.md", readme)
+    update_file(root / "README.md", readme, stale)
     for c in data["chapters"]:
-        update_file(root / "chapters" / c["chapter"] / "README.md",
+        update_file(root / "chapters" / chapter_dir(c["chapter"]) / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),
-                     "results:solvers": solvers})
+                     "results:solvers": solvers}, stale)
+    if threads is not None:  # like the scaling table: kept as it is without a new run
+        update_file(root / "chapters" / "09_threads" / "README.md",
+                    {"threads-table": threads_table(threads)}, stale)
+    if args.check:
+        # The regime sections are checked against the committed sweep only.
+        update_regimes(root, args.regimes or data_dir / "regimes.json", None, stale)
+        for s in stale:
+            print(f"stale: {s} differs from what {bench_path} gives", file=sys.stderr)
+        if stale:
+            print("update_docs.py --check: regenerate with `.venv/bin/python scripts/update_docs.py`",
+                  file=sys.stderr)
+            sys.exit(1)
+        print(f"update_docs.py --check: every generated section matches {bench_path}")
+        return
     if args.images:
         images = args.images if args.images.is_absolute() else root / args.images
         images.mkdir(parents=True, exist_ok=True)
         for png in sorted(bench_path.parent.glob("*.png")):
             shutil.copy(png, images / png.name)
             print(f"copied {png.name} to {images}")
+    update_regimes(root, args.regimes, args.images)
 
 
 if __name__ == "__main__":

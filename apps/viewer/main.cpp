@@ -18,6 +18,7 @@
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
+#include "common/threads.hpp"
 
 namespace fv = fem::viewer;
 
@@ -109,6 +110,7 @@ void write_report(const std::string& path, const RunRecord& r, const fv::Session
   out << "{\n  \"chapter\": " << fem::json_string(session.chapter())
       << ",\n  \"mesh\": " << fem::json_string(session.scene().mesh.file)
       << ",\n  \"nodes\": " << session.scene().mesh.num_nodes()
+      << ",\n  \"threads\": " << (session.uses_threads() ? fem::max_threads() : 1)
       << ",\n  \"paused\": " << (r.paused ? "true" : "false") << ",\n  \"width\": " << r.width
       << ",\n  \"height\": " << r.height
       << ",\n  \"renderer\": " << fem::json_string(renderer ? renderer : "unknown")
@@ -321,8 +323,9 @@ int main(int argc, char** argv) {
                  "Real-time viewer: drag the body with the mouse, switch chapters live.");
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
+  add_thread_option(args);
   args.option("chapter", "NAME", "stepper to start with (switch in the panel)",
-              chapters().back().id);
+              latest_chapter().id);
   args.option("frames", "N", "stop after N frames (0: run until the window is closed)", "0");
   args.option("width", "PIXELS", "window width", "1280");
   args.option("height", "PIXELS", "window height", "800");
@@ -362,6 +365,7 @@ int main(int argc, char** argv) {
         throw UsageError(e.what());
       }
     }
+    const int threads = threads_from_args(args);
     const Scene scene = scene_from_args(args);
     fv::SessionSettings settings;
     settings.scene = scene.name;
@@ -371,7 +375,8 @@ int main(int argc, char** argv) {
     settings.solver = solver_from_args(args);
     auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
     std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
-              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << "\n";
+              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", "
+              << threads << " threads for the parallel chapters\n";
 
     const Window window(options);
     run(window.handle, session, options);

@@ -72,6 +72,7 @@ class Session {
   const SessionSettings& settings() const { return settings_; }
   const std::string& chapter() const { return chapter_; }
   const StepProfile& last_profile() const { return stepper_->profile(); }
+  bool uses_threads() const { return stepper_->uses_threads(); }
   // The profiles of the last steps (oldest first), for averages and plots.
   const std::deque<StepProfile>& history() const { return history_; }
   StepProfile mean_profile() const;

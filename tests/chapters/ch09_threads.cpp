@@ -1,0 +1,228 @@
+// Chapter 09: the same answer, to the last bit, for any thread count; the same physics as
+// chapter 01; no allocation per step with threads; and a long run under a random mouse
+// spring for every chapter from 07 on.
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "chapters/08_element_kernels/stepper.hpp"
+#include "chapters/09_threads/stepper.hpp"
+#include "common/model.hpp"
+#include "common/threads.hpp"
+#include "support.hpp"
+
+using namespace fem;
+
+namespace {
+
+// The sliding scene with its fixed corner driven sideways: every filter case (free, plane,
+// line, fixed) and a prescribed velocity change.
+Scene driven_scene() {
+  Scene scene = test::test_scene("sliding");
+  for (auto& c : scene.constraints)
+    if (c.kind == NodeConstraint::Kind::Fixed) c.target_velocity = Eigen::Vector3d(0.0, 0.05, 0.01);
+  scene.name = "driven";
+  return scene;
+}
+
+// 1, 2 and 3 threads with OpenMP (3: a count that divides nothing evenly); 1 without.
+std::vector<int> thread_counts() {
+  return openmp_enabled() ? std::vector<int>{1, 2, 3} : std::vector<int>{1};
+}
+
+State run_with(const Scene& scene, int threads, int steps, ch09::ElementParallelism how) {
+  const ThreadCountScope scope(threads);
+  ch09::ThreadsStepper stepper(scene, {}, how);
+  State state = rest_state(scene);
+  for (int k = 0; k < steps; ++k) stepper.step(state);
+  return state;
+}
+
+bool bit_identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.array() == b.array()).all();
+}
+
+}  // namespace
+
+TEST_CASE("ch09: bit-identical states after 50 steps with 1, 2 and 3 threads", "[ch09]") {
+  for (const auto how : {ch09::ElementParallelism::colouring, ch09::ElementParallelism::gather})
+    for (const Scene& scene : {test::test_scene("cantilever"), driven_scene()}) {
+      const State reference = run_with(scene, 1, 50, how);
+      REQUIRE((reference.x - rest_state(scene).x).cwiseAbs().maxCoeff() > 1e-3);  // it moves
+      for (const int threads : thread_counts()) {
+        const State state = run_with(scene, threads, 50, how);
+        INFO(scene.name << ", " << threads << " threads, "
+                        << (how == ch09::ElementParallelism::gather ? "gather" : "colouring"));
+        CHECK(bit_identical(state.x, reference.x));
+        CHECK(bit_identical(state.v, reference.v));
+      }
+    }
+}
+
+TEST_CASE("ch09: matches chapter 01 on both scenes and a driven scene over 50 steps", "[ch09]") {
+  const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
+  for (const Scene& scene :
+       {test::test_scene("cantilever"), test::test_scene("sliding"), driven_scene()})
+    test::check_matches_ch01("09", scene);
+}
+
+TEST_CASE("ch09: the system equals chapter 08's, by either element pass", "[ch09]") {
+  const Scene scene = driven_scene();
+  const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
+  ch08::ElementKernelsStepper serial(scene, test::tight_solver());
+  ch09::ThreadsStepper colouring(scene, test::tight_solver(), ch09::ElementParallelism::colouring);
+  ch09::ThreadsStepper gather(scene, test::tight_solver(), ch09::ElementParallelism::gather);
+  CHECK(colouring.colours() > 1);
+  State state = rest_state(scene);
+  for (int k = 0; k < 5; ++k) {
+    State a = state, b = state, c = state;  // the same input state: only rounding may differ
+    serial.step(a);
+    colouring.step(b);
+    gather.step(c);
+    const Eigen::SparseMatrix<double> A = serial.system_matrix().to_sparse();
+    CHECK((A - colouring.system_matrix().to_sparse()).norm() <= 1e-13 * A.norm());
+    // The gather adds each block's terms in element order, as the serial pass: the same bits.
+    CHECK((A - gather.system_matrix().to_sparse()).norm() == 0.0);
+    const Eigen::VectorXd& rhs = serial.system_rhs();
+    CHECK((rhs - colouring.system_rhs()).norm() <= 1e-13 * rhs.norm());
+    CHECK(bit_identical(gather.system_rhs(), rhs));
+    state = a;
+  }
+}
+
+TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thread count",
+          "[ch09]") {
+  const Scene scene = driven_scene();
+  ch09::ThreadsStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  const ch09::BlockSparseMatrix& A = stepper.system_matrix();
+  const Eigen::VectorXd& b = stepper.system_rhs();
+  Eigen::VectorXd first;
+  for (const int threads : thread_counts()) {
+    const ThreadCountScope scope(threads);
+    ch09::ParallelPcg pcg(A, stepper.diagonal_blocks(), scene.constraints);
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(b.size()), Ay(b.size());
+    const ch09::PcgResult result = pcg.solve(A, b, test::tight_solver(), y);
+    A.multiply(y, Ay);
+    INFO(threads << " threads: " << result.iterations << " iterations");
+    CHECK(result.converged);
+    CHECK((b - Ay).norm() <= 1e-11 * b.norm());
+    if (first.size() == 0) first = y;
+    CHECK(bit_identical(y, first));
+  }
+}
+
+TEST_CASE("ch09: zero heap allocations per step after the first, with 2 threads",
+          "[ch09][alloc]") {
+  FEM_REQUIRE_ALLOCATION_COUNTER();
+  // The counter sees every thread's allocations. OpenMP's set-up, the first time a region
+  // has a team of a new size (libgomp's threads and its team structure), falls in the first
+  // step, with the stepper's own first-step sizing; libgomp keeps that team for the next
+  // regions of the same size, so the steps after it allocate nothing.
+  const int threads = openmp_enabled() ? 2 : 1;
+  const ThreadCountScope scope(threads);
+  for (const Scene& scene : {test::test_scene("cantilever"), driven_scene()}) {
+    INFO(scene.name << ", " << threads << " threads");
+    CHECK(test::allocations_per_step("09", scene) == 0);
+  }
+}
+
+TEST_CASE("ch09: one thread opens no parallel region, so it allocates nothing either",
+          "[ch09][alloc]") {
+  FEM_REQUIRE_ALLOCATION_COUNTER();
+  // libgomp frees a team of one thread at the end of each region (gomp_team_end): a region
+  // per phase would cost a malloc each. run_parallel calls the body directly instead.
+  const ThreadCountScope scope(1);
+  CHECK(test::allocations_per_step("09", driven_scene()) == 0);
+}
+
+TEST_CASE("ch09: --threads style errors: a count below 1 is refused", "[ch09]") {
+  CHECK_THROWS_AS(set_threads(0), std::invalid_argument);
+  if (!openmp_enabled()) CHECK_THROWS_AS(set_threads(2), std::invalid_argument);
+}
+
+namespace {
+
+// Kinetic + elastic + gravitational energy; its change from rest stays bounded when the body
+// neither gains energy from nowhere nor diverges.
+double total_energy(const Model& model, const Scene& scene, const State& state) {
+  const double kinetic = 0.5 * state.v.dot(model.lumped_mass.cwiseProduct(state.v));
+  return kinetic + elastic_energy(model, scene, state.x) - model.gravity_force.dot(state.x);
+}
+
+struct SoakResult {
+  State state;
+  double max_energy_early = 0.0, max_energy = 0.0;
+  int not_converged = 0;
+  std::string diverged;
+};
+
+// A few thousand steps with a mouse spring on a random surface node that jumps to another
+// node every few steps, pulling towards a random point near the node's rest position. The
+// same seed gives every chapter the same sequence of nodes and targets.
+SoakResult soak(const std::string& chapter, const Scene& scene, int threads, int steps) {
+  const ThreadCountScope scope(threads);
+  auto stepper = make_stepper(chapter, scene, {});
+  const Model model(scene);
+  std::vector<int> surface;
+  for (const auto& t : scene.mesh.boundary)
+    for (int a = 0; a < 3; ++a) surface.push_back(t[a]);
+  std::sort(surface.begin(), surface.end());
+  surface.erase(std::unique(surface.begin(), surface.end()), surface.end());
+  std::mt19937 random(2026);
+  std::uniform_int_distribution<std::size_t> pick(0, surface.size() - 1);
+  std::uniform_real_distribution<double> offset(-0.15, 0.15);
+  // Stiff enough to pull the body around: its weight over 5 cm.
+  const double stiffness = model.lumped_mass.sum() / 3.0 * 9.81 / 0.05;
+  int node = 0;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  SoakResult out;
+  out.state = rest_state(scene);
+  const double rest_energy = total_energy(model, scene, out.state);
+  for (int k = 0; k < steps; ++k) {
+    if (k % 7 == 0) {
+      node = surface[pick(random)];
+      target = scene.mesh.X.col(node) + Eigen::Vector3d(offset(random), offset(random), offset(random));
+    }
+    stepper->set_external_forces(
+        {{node, stiffness * (target - out.state.x.segment<3>(3 * node))}});
+    stepper->step(out.state);
+    if (const char* why = divergence(out.state, stepper->profile())) {
+      out.diverged = why;
+      return out;
+    }
+    out.not_converged += stepper->profile().converged ? 0 : 1;
+    if (k % 20 == 0) {
+      const double energy = std::abs(total_energy(model, scene, out.state) - rest_energy);
+      out.max_energy = std::max(out.max_energy, energy);
+      if (k < steps / 10) out.max_energy_early = out.max_energy;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("ch09: soak, thousands of steps under a random mouse spring, chapters 07 on",
+          "[ch09][soak]") {
+  const Scene scene = test::test_scene("cantilever");
+  const int steps = 3000;
+  std::vector<std::pair<std::string, int>> runs = {{"07", 1}, {"08", 1}, {"09", 1}};
+  if (openmp_enabled()) runs.push_back({"09", 2});
+  std::vector<SoakResult> results;
+  for (const auto& [chapter, threads] : runs) {
+    results.push_back(soak(chapter, scene, threads, steps));
+    const SoakResult& r = results.back();
+    INFO("chapter " << chapter << " on " << threads << " threads");
+    CHECK(r.diverged.empty());
+    CHECK(r.not_converged == 0);
+    // Bounded: the energy of the whole run stays within a small multiple of what the spring
+    // put in during the first tenth (damping takes out what the spring puts in).
+    CHECK(r.max_energy_early > 0.0);
+    CHECK(r.max_energy < 10.0 * r.max_energy_early);
+  }
+  if (openmp_enabled()) {
+    CHECK(bit_identical(results[2].state.x, results[3].state.x));
+    CHECK(bit_identical(results[2].state.v, results[3].state.v));
+  }
+}
