@@ -229,6 +229,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
   for (std::size_t e = 0; e < m; ++e)
     F[e] = deformation_gradient(model.rest[e], gather(state.x, model.tets[e]));
   const std::vector<Eigen::Quaterniond> previous = stepper.rotations();
+  const std::vector<Eigen::Quaterniond> before = stepper.previous_rotations();
   std::vector<Eigen::Quaterniond> q(m);
 
   const int repeat = std::max(5, steps);
@@ -245,7 +246,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       if (undecided > 0) s << " (" << undecided << " undecided)";
       return s.str();
     }
-  } count_cold, count_warm;
+  } count_cold, count_warm, count_predicted;
   const double svd = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(F[e]);
   });
@@ -266,9 +267,16 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       count_warm.add(ch08::newton_polar_rotation(F[e], q[e]));
     }
   });
+  const double predicted = to_ns * time_ms(repeat, [&] {
+    count_predicted = Count{};
+    for (std::size_t e = 0; e < m; ++e) {
+      q[e] = ch08::predicted_rotation(previous[e], before[e]);
+      count_predicted.add(ch08::newton_polar_rotation(F[e], q[e]));
+    }
+  });
   const double fast = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) {
-      q[e] = previous[e];
+      q[e] = ch08::predicted_rotation(previous[e], before[e]);
       R[e] = ch08::fast_polar_rotation(F[e], q[e], fallbacks);
     }
   });
@@ -296,6 +304,8 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
   // How often the stepper falls back to the SVD on the benchmark's scenes.
   std::ostringstream scenes;
   for (const std::string& name : scene_names()) {
+    std::cerr << "fem_lessons rotations: " << steps << " steps of the " << name
+              << " scene, counting SVD fallbacks\n";
     Scene scene = make_scene(name, bench_scene.mesh, bench_scene.material);
     scene.dt = bench_scene.dt;
     ch08::ElementKernelsStepper run(scene, {});
@@ -305,6 +315,7 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
            << static_cast<long long>(steps) * static_cast<long long>(m);
   }
 
+  const auto mib = [m](std::size_t bytes) { return static_cast<double>(bytes * m) / (1 << 20); };
   const BuildInfo info = build_info();
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
@@ -318,16 +329,21 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
       << std::setprecision(1) << "| Newton, warm (from the previous step's rotation) | " << warm
       << " | " << std::setprecision(2) << svd / warm << "x | " << count_warm.mean(m) << " |\n"
       << std::setprecision(1)
-      << "| warm Newton with the SVD fallback, as the stepper calls it (chapter 08) | " << fast
+      << "| Newton, warm (predicted from the last two steps' rotations) | " << predicted
+      << " | " << std::setprecision(2) << svd / predicted << "x | " << count_predicted.mean(m)
+      << " |\n"
+      << std::setprecision(1)
+      << "| predicted start, Newton, SVD fallback: the stepper's (chapter 08) | " << fast
       << " | " << std::setprecision(2) << svd / fast << "x | - |\n\n";
   out << std::setprecision(1)
-      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data read (bytes) |\n"
-      << "| --- | ---: | ---: | ---: |\n"
+      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data per element "
+         "(bytes) | rest data per step (MiB) |\n"
+      << "| --- | ---: | ---: | ---: | ---: |\n"
       << "| sixteen `-R K0_ab R^T` from the stored K0 (chapter 07) | " << stored << " | 1.00x | "
-      << sizeof(ElementRest) << " |\n"
-      << "| ten closed-form blocks from the shape gradients (chapter 08) | " << closed << " | "
-      << std::setprecision(2) << stored / closed << "x | " << sizeof(ch08::ElementShape)
-      << " |\n\n";
+      << sizeof(ElementRest) << " | " << std::setprecision(2) << mib(sizeof(ElementRest)) << " |\n"
+      << std::setprecision(1) << "| ten closed-form blocks from the shape gradients (chapter 08) | "
+      << closed << " | " << std::setprecision(2) << stored / closed << "x | "
+      << sizeof(ch08::ElementShape) << " | " << mib(sizeof(ch08::ElementShape)) << " |\n\n";
   out << std::setprecision(1) << "Step 21 of the " << bench_scene.name << " scene on "
       << std::filesystem::path(bench_scene.mesh.file).filename().string() << " ("
       << bench_scene.mesh.num_tets() << " tets); median of " << repeat

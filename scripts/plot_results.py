@@ -65,20 +65,22 @@ def plot_speedup(data, out):
         finish(fig, data, out / "speedup.png")
         return
     others = [c for c in chapters if c is not base]
-    x = np.arange(len(PHASES))
+    # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
+    phases = ["forces"] + PHASES
+    x = np.arange(len(phases))
     width = 0.8 / (len(others) + 1)
     for i, c in enumerate(others):
         # A phase a chapter no longer has (chapter 08's df/dx, fused into its element pass) gets
         # no bar rather than an infinite one.
         s = [base["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
-             for p in PHASES]
+             for p in phases]
         ax.bar(x + (i - len(others) / 2) * width, s, width, label=c["chapter"])
-    poster = [POSTER_SPEEDUPS.get(p, np.nan) for p in PHASES]
+    poster = [POSTER_SPEEDUPS.get(p, np.nan) for p in phases]
     ax.bar(x + (len(others) - len(others) / 2) * width, poster, width, color="none",
            edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
-    ax.set_xticks(x, [PHASE_LABELS[p] for p in PHASES])
+    ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
     ax.set_title("Speedup per phase over the naive stepper, beside the poster's")
     ax.legend(fontsize=8, ncol=2)
