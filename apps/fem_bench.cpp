@@ -589,6 +589,9 @@ int main(int argc, char** argv) {
     std::cout << (openmp_enabled() ? "" : " (built without OpenMP)") << "\n";
     const double load_before = load_average();
     std::cout << "load average (1 min): " << load_before << "\n";
+    if (thread_counts.size() > 1 && load_before > 0.5 * hardware_threads())
+      std::cout << "  note: the machine is busy; threads that wait for each other at barriers "
+                   "suffer most from it (the JSON records the load)\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
     std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";

@@ -99,10 +99,6 @@ constexpr double kMinRelativeDet = 1e-4;
 constexpr double kConvergedStep = 1e-8;
 constexpr int kMaxIterations = 12;
 
-}  // namespace
-
-namespace {
-
 // |q|^2 R(q / |q|), the rotation of a quaternion that need not be unit, without a division.
 Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
   const double w = q.w(), x = q.x(), y = q.y(), z = q.z();
@@ -111,6 +107,24 @@ Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
       2.0 * (x * y + w * z), w * w - x * x + y * y - z * z, 2.0 * (y * z - w * x),   //
       2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z;
   return R;
+}
+
+// x = H^-1 b for a symmetric 3x3 H by its adjugate: no pivoting, no LU. False where H is not
+// positive definite (Sylvester's criterion) or det H <= min_det, nearly singular.
+bool solve_positive_definite(const Eigen::Matrix3d& H, const Eigen::Vector3d& b, double min_det,
+                             Eigen::Vector3d& x) {
+  const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
+  const double det = H.determinant();
+  if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > min_det)) return false;  // also NaN
+  Eigen::Matrix3d adjugate;
+  adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2), H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2),
+      H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
+      H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 0) * H(2, 2) - H(0, 2) * H(0, 2),
+      H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2),  //
+      H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1), H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2), minor2;
+  x.noalias() = adjugate * b;
+  x /= det;
+  return true;
 }
 
 }  // namespace
@@ -128,19 +142,11 @@ int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q) {
     const Eigen::Vector3d axial(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1));
     Eigen::Matrix3d H = -0.5 * (A + A.transpose());
     H.diagonal().array() += A.trace();
-    // Sylvester's criterion, and the adjugate solve of a symmetric 3x3: no pivoting, no LU.
-    const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
-    const double det = H.determinant();
+    // A, and so H, carries the factor |q|^2: the singularity test is scaled with it.
     const double q2 = q.squaredNorm();
-    if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2)))
+    Eigen::Vector3d w;
+    if (!solve_positive_definite(H, axial, 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2), w))
       return -1;
-    Eigen::Matrix3d adjugate;
-    adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2), H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2),
-        H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
-        H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 0) * H(2, 2) - H(0, 2) * H(0, 2),
-        H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2),  //
-        H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1), H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2), minor2;
-    const Eigen::Vector3d w = adjugate * axial / det;
     // exp([w]) to second order as the quaternion (1, w/2): a rotation once normalized, and
     // Newton's quadratic convergence is kept.
     q = q * Eigen::Quaterniond(1.0, 0.5 * w.x(), 0.5 * w.y(), 0.5 * w.z());

@@ -141,10 +141,6 @@ constexpr double kMinRelativeDet = 1e-4;
 constexpr double kConvergedStep = 1e-8;
 constexpr int kMaxIterations = 12;
 
-}  // namespace
-
-namespace {
-
 // |q|^2 R(q / |q|), the rotation of a quaternion that need not be unit, without a division.
 Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
   const double w = q.w(), x = q.x(), y = q.y(), z = q.z();
@@ -153,6 +149,24 @@ Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
       2.0 * (x * y + w * z), w * w - x * x + y * y - z * z, 2.0 * (y * z - w * x),   //
       2.0 * (x * z - w * y), 2.0 * (y * z + w * x), w * w - x * x - y * y + z * z;
   return R;
+}
+
+// x = H^-1 b for a symmetric 3x3 H by its adjugate: no pivoting, no LU. False where H is not
+// positive definite (Sylvester's criterion) or det H <= min_det, nearly singular.
+bool solve_positive_definite(const Eigen::Matrix3d& H, const Eigen::Vector3d& b, double min_det,
+                             Eigen::Vector3d& x) {
+  const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
+  const double det = H.determinant();
+  if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > min_det)) return false;  // also NaN
+  Eigen::Matrix3d adjugate;
+  adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2), H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2),
+      H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
+      H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 0) * H(2, 2) - H(0, 2) * H(0, 2),
+      H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2),  //
+      H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1), H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2), minor2;
+  x.noalias() = adjugate * b;
+  x /= det;
+  return true;
 }
 
 }  // namespace
@@ -170,19 +184,11 @@ int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q) {
     const Eigen::Vector3d axial(A(2, 1) - A(1, 2), A(0, 2) - A(2, 0), A(1, 0) - A(0, 1));
     Eigen::Matrix3d H = -0.5 * (A + A.transpose());
     H.diagonal().array() += A.trace();
-    // Sylvester's criterion, and the adjugate solve of a symmetric 3x3: no pivoting, no LU.
-    const double minor2 = H(0, 0) * H(1, 1) - H(0, 1) * H(0, 1);
-    const double det = H.determinant();
+    // A, and so H, carries the factor |q|^2: the singularity test is scaled with it.
     const double q2 = q.squaredNorm();
-    if (!(H(0, 0) > 0.0 && minor2 > 0.0 && det > 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2)))
+    Eigen::Vector3d w;
+    if (!solve_positive_definite(H, axial, 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2), w))
       return -1;
-    Eigen::Matrix3d adjugate;
-    adjugate << H(1, 1) * H(2, 2) - H(1, 2) * H(1, 2), H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2),
-        H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1),  //
-        H(0, 2) * H(1, 2) - H(0, 1) * H(2, 2), H(0, 0) * H(2, 2) - H(0, 2) * H(0, 2),
-        H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2),  //
-        H(0, 1) * H(1, 2) - H(0, 2) * H(1, 1), H(0, 1) * H(0, 2) - H(0, 0) * H(1, 2), minor2;
-    const Eigen::Vector3d w = adjugate * axial / det;
     // exp([w]) to second order as the quaternion (1, w/2): a rotation once normalized, and
     // Newton's quadratic convergence is kept.
     q = q * Eigen::Quaterniond(1.0, 0.5 * w.x(), 0.5 * w.y(), 0.5 * w.z());
@@ -241,7 +247,10 @@ ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& setting
       lame_from_young_poisson(scene.material.youngs_modulus, scene.material.poisson_ratio);
   shapes_.reserve(model_.tets.size());
   for (const ElementRest& rest : model_.rest) shapes_.push_back(make_element_shape(rest, lame));
-  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());  // the rest shape
+  // The rest shape's, as a start: a stepper created on a deformed body (the viewer switching
+  // chapters) starts cold, and Newton or the SVD fallback finds the rotations.
+  rotations_.assign(model_.tets.size(), Eigen::Quaterniond::Identity());
+  previous_rotations_ = rotations_;
 
   // The pattern, once: a block per pair of nodes that share a tetrahedron. Where each
   // element's 16 blocks sit, the diagonal blocks and the transposes are found once too.
@@ -318,8 +327,8 @@ void ThreadsStepper::step(State& state) {
     start_system(state);
   }
   {
-    // The fused pass: rotations, forces and the blocks of df/dx, written into A and b.
-    // It does the work of the forces, df/dx and composition phases of chapter 07 and is
+    // The fused pass: rotations, forces and the blocks of df/dx, written into A and b. It
+    // does the work of the earlier chapters' forces, df/dx and composition phases and is
     // reported under forces; dfdx stays zero, because no df/dx is built.
     PhaseTimer t(profile_.forces);
     element_pass(state);
@@ -372,7 +381,11 @@ void ThreadsStepper::element_terms(int e, const State& state, long long& fallbac
     Ds.col(i) = state.x.segment<3>(3 * t[i + 1]) - state.x.segment<3>(3 * t[0]);
     Dv.col(i) = state.v.segment<3>(3 * t[i + 1]) - state.v.segment<3>(3 * t[0]);
   }
-  const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, rotations_[e], fallbacks);
+  Eigen::Quaterniond q = predicted_rotation(rotations_[e], previous_rotations_[e]);
+  const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks);
+  // The first step has no angular velocity to extrapolate: the next starts from R itself.
+  previous_rotations_[e] = first_step_ ? q : rotations_[e];
+  rotations_[e] = q;
   const Eigen::Matrix<double, 3, 4> r = rotated_gradients(R, shape.Dm_inv);
 
   // b_a += h f_a + h df/dx_a ((h + beta) v) without K0: both are -V P r_a with the linear
@@ -392,6 +405,7 @@ void ThreadsStepper::element_pass(const State& state) {
     element_pass_gather(state);
   else
     element_pass_colouring(state);
+  first_step_ = false;
 }
 
 namespace {
@@ -630,6 +644,13 @@ PcgResult ParallelPcg::solve(const BlockSparseMatrix& A, const Eigen::VectorXd& 
         partial_pq_[c] = p_.segment(3 * first, size).dot(q_.segment(3 * first, size));
       }
       const double step = rho / sum_in_order(partial_pq_);
+      // An overflowing system (an absurd E) overflows here: stop before y does, with a
+      // residual that says so, rather than iterate on NaN up to the cap. Every thread sees
+      // the same step, so every thread stops.
+      if (!std::isfinite(step)) {
+        residual_norm2 = std::numeric_limits<double>::quiet_NaN();
+        break;
+      }
       // Every vector operation of the iteration that needs no neighbour, on one chunk at a
       // time while it sits in L1: y += step p, r -= step q, r filtered, s = S D^-1 r,
       // ||r||^2 and r . s. Each is an Eigen expression on the chunk's segment, so it keeps

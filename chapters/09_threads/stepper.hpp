@@ -27,14 +27,23 @@ struct ElementShape {
 ElementShape make_element_shape(const ElementRest& rest, const Lame& lame);
 
 // The rotation of the polar decomposition F = R S by Newton's method on the rotations,
-// started from q (the previous step's rotation: the warm start) and written back to q.
+// started from q (the warm start: predicted from the last steps' rotations) and written
+// back to q.
 // Returns the number of iterations, or -1 where Newton cannot decide: F inverted, flat or
 // collapsed (det F too small against |F|^3), or an iterate outside the basin of the polar
 // rotation (where R^T F is not positive definite enough to give a Newton step), or no
 // convergence within the iteration cap. q is unusable after -1.
 int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q);
 
-// The rotation common/'s polar_rotation returns (to about 1e-13, see the tests), by Newton
+// Newton's start: the rotation extrapolated at constant angular velocity from the last two
+// steps', R_k R_{k-1}^T R_k. Its error is the change of the angular velocity, second order
+// in the time step, where the last rotation alone is first order: one Newton iteration less.
+inline Eigen::Quaterniond predicted_rotation(const Eigen::Quaterniond& last,
+                                             const Eigen::Quaterniond& before) {
+  return last * before.conjugate() * last;
+}
+
+// The rotation common/'s polar_rotation returns (to 1e-12 per entry, the tests), by Newton
 // from q where it decides, and by common/'s SVD where it does not (then ++fallbacks). q
 // holds the answer on exit, the next step's warm start.
 Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
@@ -152,8 +161,9 @@ class ThreadsStepper final : public Stepper {
   const BlockSparseMatrix& system_matrix() const { return A_; }
   const Eigen::VectorXd& system_rhs() const { return filtered_b_; }
   const std::vector<int>& diagonal_blocks() const { return diagonal_block_; }
-  // Per element, the rotation of the last step (the next step's warm start).
+  // Per element, the rotations of the last two steps (the next step's warm start).
   const std::vector<Eigen::Quaterniond>& rotations() const { return rotations_; }
+  const std::vector<Eigen::Quaterniond>& previous_rotations() const { return previous_rotations_; }
   const std::vector<ElementShape>& shapes() const { return shapes_; }
   // Elements whose rotation came from the SVD because Newton could not decide: in the
   // last step, and in all steps so far.
@@ -180,7 +190,9 @@ class ThreadsStepper final : public Stepper {
   bool warned_not_converged_ = false;
 
   std::vector<ElementShape> shapes_;
-  std::vector<Eigen::Quaterniond> rotations_;  // R_e, the warm start of the next step
+  std::vector<Eigen::Quaterniond> rotations_;           // R_e of the last step
+  std::vector<Eigen::Quaterniond> previous_rotations_;  // R_e of the step before
+  bool first_step_ = true;
   long long last_step_fallbacks_ = 0, total_fallbacks_ = 0;
   std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b) in A
   RowChunks chunks_;
