@@ -3,7 +3,7 @@
 //    sweeps, prolongator) and reports median PCG iterations and solve time per step;
 //  - on the last step's filtered system: the hierarchy (levels, unknowns, blocks), the cost
 //    of prepare() and of one V-cycle in SpMV-equivalents, and PCG from a zero guess with the
-//    V-cycle, with chapter 07's block Jacobi and with Eigen's IncompleteCholesky CG;
+//    V-cycle, with chapter 09's block Jacobi and with Eigen's IncompleteCholesky CG;
 //  - with --export DIR: that system as Matrix Market (A.mtx, b.mtx, the filtered rigid-body
 //    modes B.mtx) and summary.json, for scripts/pyamg_reference.py.
 #include <Eigen/IterativeLinearSolvers>
@@ -18,7 +18,7 @@
 #include <unsupported/Eigen/SparseExtra>
 #include <vector>
 
-#include "chapters/07_block_sparse/stepper.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/cli.hpp"
 #include "common/model.hpp"
@@ -153,24 +153,23 @@ int run(const ArgParser& args) {
   const double vcycle = time_ms(10 * repeat, [&] { mg.apply(b, y); });
 
   // PCG from zero on the same system: the V-cycle, block Jacobi, Eigen's IC.
-  ch10::PcgWorkspace work;
+  ch10::ParallelPcg pcg(A, scene.constraints);
   Eigen::VectorXd y10 = Eigen::VectorXd::Zero(b.size());
-  const ch10::PcgResult r10 = ch10::pcg_solve(A, mg, b, scene.constraints, solver, work, y10);
+  const ch10::PcgResult r10 = pcg.solve(A, mg, b, solver, y10);
   const double pcg10 = time_ms(5, [&] {
     y10.setZero();
-    ch10::pcg_solve(A, mg, b, scene.constraints, solver, work, y10);
+    pcg.solve(A, mg, b, solver, y10);
   });
-  ch07::BlockSparseMatrix A7;
-  A7.row_start = A.row_start;
-  A7.column = A.column;
-  A7.blocks = A.blocks;
-  ch07::PcgWorkspace work7;
-  Eigen::VectorXd y7 = Eigen::VectorXd::Zero(b.size());
-  const ch07::PcgResult r7 =
-      ch07::pcg_solve(A7, stepper.diagonal_blocks(), b, scene.constraints, solver, work7, y7);
-  const double pcg7 = time_ms(5, [&] {
-    y7.setZero();
-    ch07::pcg_solve(A7, stepper.diagonal_blocks(), b, scene.constraints, solver, work7, y7);
+  ch09::BlockSparseMatrix A9;
+  A9.row_start = A.row_start;
+  A9.column = A.column;
+  A9.blocks = A.blocks;
+  ch09::ParallelPcg pcg9(A9, stepper.diagonal_blocks(), scene.constraints);
+  Eigen::VectorXd y9 = Eigen::VectorXd::Zero(b.size());
+  const ch09::PcgResult r9 = pcg9.solve(A9, b, solver, y9);
+  const double pcg9_ms = time_ms(5, [&] {
+    y9.setZero();
+    pcg9.solve(A9, b, solver, y9);
   });
   const Eigen::SparseMatrix<double> csc = A.to_sparse();
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
@@ -196,8 +195,8 @@ int run(const ArgParser& args) {
             << " (CPU ms of this thread):\n"
             << "  V-cycle (chapter 10)          " << std::setw(5) << r10.iterations
             << " iterations, " << pcg10 << " ms (plus prepare)\n"
-            << "  block Jacobi (chapter 07)     " << std::setw(5) << r7.iterations
-            << " iterations, " << pcg7 << " ms\n"
+            << "  block Jacobi (chapter 09)     " << std::setw(5) << r9.iterations
+            << " iterations, " << pcg9_ms << " ms\n"
             << "  Eigen IncompleteCholesky CG   " << std::setw(5) << ic.iterations()
             << " iterations, " << ic_ms << " ms (compute + solve)\n";
 
@@ -211,7 +210,7 @@ int run(const ArgParser& args) {
         << "{\"mesh\": \"" << std::filesystem::path(scene.mesh.file).filename().string()
         << "\", \"scene\": \"" << scene.name << "\", \"nodes\": " << scene.mesh.num_nodes()
         << ", \"tolerance\": " << std::defaultfloat << solver.tolerance << ", \"ours_iterations\": " << r10.iterations
-        << ", \"block_jacobi_iterations\": " << r7.iterations
+        << ", \"block_jacobi_iterations\": " << r9.iterations
         << ", \"ours_levels\": " << mg.levels() << "}\n";
     std::cout << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
   }

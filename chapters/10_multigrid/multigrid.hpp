@@ -9,7 +9,7 @@
 // only numbers on those fixed patterns, and apply(r, z) is one V-cycle. Neither allocates.
 //
 // The multigrid knows nothing of the stepper: it reads the fine matrix as block compressed
-// rows (row_start, column, blocks), the layout of chapter 07's BlockSparseMatrix.
+// rows (row_start, column, blocks), the layout of the stepper's BlockSparseMatrix.
 #pragma once
 
 #include <Eigen/Cholesky>
