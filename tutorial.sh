@@ -216,6 +216,10 @@ docs() {
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
+  log "multigrid tables (fem_multigrid, scripts/pyamg_reference.py: about half a minute)"
+  "$BUILD_DIR/fem_multigrid" --steps 20 --threads 1 --readme chapters/10_multigrid/README.md >/dev/null
+  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_multigrid" \
+    --readme chapters/10_multigrid/README.md >/dev/null
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
   for json in bench scaling viewer regimes threads; do
