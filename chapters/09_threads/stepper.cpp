@@ -1,4 +1,4 @@
-// Chapter 08: one linearized backward Euler step (Baraff & Witkin 1998),
+// Chapter 09: one linearized backward Euler step (Baraff & Witkin 1998),
 //   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
