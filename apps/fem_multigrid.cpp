@@ -96,22 +96,6 @@ Eigen::MatrixXd rigid_body_modes(const Scene& scene) {
   return B;
 }
 
-// Replaces the text between <!-- NAME:begin --> and <!-- NAME:end --> in a file.
-void write_between_markers(const std::string& path, const std::string& name,
-                           const std::string& text) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read '" + path + "'");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string doc = buffer.str();
-  const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
-  const auto b = doc.find(begin), e = doc.find(end);
-  if (b == std::string::npos || e == std::string::npos || e < b)
-    throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
-  doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
-  std::ofstream(path) << doc;
-}
-
 int run(const ArgParser& args) {
   const int threads = threads_from_args(args);
   const Scene scene = scene_from_args(args);

@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
@@ -201,6 +203,21 @@ int threads_from_args(const ArgParser& args) {
     }
   }
   return max_threads();
+}
+
+void write_between_markers(const std::string& path, const std::string& name,
+                           const std::string& text) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read '" + path + "'");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string doc = buffer.str();
+  const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
+  const auto b = doc.find(begin), e = doc.find(end);
+  if (b == std::string::npos || e == std::string::npos || e < b)
+    throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
+  doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
+  std::ofstream(path) << doc;
 }
 
 }  // namespace fem

@@ -63,4 +63,10 @@ int threads_from_args(const ArgParser& args);
 // A relative mesh path is looked up from the working directory, then from the repository.
 std::string resolve_mesh_path(const std::string& path);
 
+// --readme FILE of the programs that generate docs: replaces the text between the lines
+// <!-- NAME:begin --> and <!-- NAME:end --> of the file. Throws std::runtime_error when the
+// file cannot be read or has no such markers.
+void write_between_markers(const std::string& path, const std::string& name,
+                           const std::string& text);
+
 }  // namespace fem
