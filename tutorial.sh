@@ -13,6 +13,8 @@ VENV="$ROOT/.venv"
 APT_PACKAGES=(
   build-essential cmake ninja-build git python3 python3-venv
   libeigen3-dev catch2
+  # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
+  libsuitesparse-dev
   # gmsh's runtime libraries (the PyPI wheel links against them)
   libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
   # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
@@ -28,18 +30,28 @@ commands:
   setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
   build      set up if needed and build (preset: \$PRESET, default release)
   test       build and run every test through ctest (ctest arguments may follow, e.g. -L ch01)
-  bench      build and benchmark every chapter on the poster-sized mesh:
-             prints the per-phase table, writes results/bench.json (and plots when present)
+  bench      build (quietly) and benchmark every chapter on the poster-sized mesh: prints the
+             per-phase table; a run is a folder, --out DIR (default results) gets bench.json
+             and the plots made from it; other arguments go to fem_bench (--chapters 06,07,
+             --mesh, --scene, --steps; fem_bench --help)
+  plots      remake the plots of a run folder from its bench.json: ./tutorial.sh plots DIR
+  variant    copy a chapter under a new name to change it and measure it against the
+             original: ./tutorial.sh variant 06 my_fused_updates (chapters/README.md)
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
+  regimes    build and run every chapter on both poster-sized bodies (the thin plate, the perforated
+             bar) over a sweep of Young's modulus, with the solve table at each point (about 10
+             minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
+             scripts/regimes.py (--help)
   threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
              thread on the poster-sized mesh: results/threads.json and results/threads.png
              (step and solve time against threads, with the ideal line)
-  docs       regenerate the generated parts of the docs from results/ (tables in docs/results.md,
-             the README and the chapter READMEs, plots copied to docs/images/), the lesson
+  docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
+             of the docs from it (tables in docs/results.md, the README and the chapter
+             READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
-             (docs/images/viewer.png, headless); run bench first (scaling and viewer-bench
+             (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
@@ -115,25 +127,63 @@ build() {
   cmake --build --preset "$PRESET"
 }
 
+# The build with its log kept out of the way of the results that follow: a summary line, the
+# log's tail on failure, and the warnings (if any) named.
+quiet_build() {
+  setup
+  local build_log="$BUILD_DIR/build.log"
+  log "building (preset $PRESET; log in ${build_log#"$ROOT"/})"
+  if ! cmake --build --preset "$PRESET" >"$build_log" 2>&1; then
+    tail -n 40 "$build_log" >&2
+    echo "the build failed: the whole log is $build_log" >&2
+    exit 1
+  fi
+  local warnings
+  warnings=$(grep -c "warning:" "$build_log" || true)
+  [ "$warnings" -eq 0 ] || echo "the build printed $warnings warnings: see $build_log" >&2
+}
+
 run_tests() {
   build
   log "running the tests"
   ctest --preset "$PRESET" -j "$(nproc)" "$@"
 }
 
+# A run is a folder: fem_bench writes DIR/bench.json and the plots are made from that file,
+# so plots and numbers always belong together.
 bench() {
-  build
-  mkdir -p results
-  log "benchmarking every chapter on the poster-sized mesh"
-  "$BUILD_DIR/fem_bench" --json results/bench.json "$@"
-  if [ -f scripts/plot_results.py ]; then
-    log "plotting"
-    "$VENV/bin/python" scripts/plot_results.py results/bench.json --out results
-  fi
+  local out=results json="" args=("$@") i  # fem_bench's defaults
+  for ((i = 0; i < ${#args[@]}; i++)); do
+    case "${args[i]}" in
+      --out) out="${args[i + 1]:-}" ;;
+      --json) json="${args[i + 1]:-}" ;;
+    esac
+  done
+  [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; }
+  [ -n "$json" ] || json="$out/bench.json"
+  quiet_build
+  log "benchmarking: fem_bench $* (the run's folder: $out/)"
+  "$BUILD_DIR/fem_bench" "$@"
+  plots "$json" "$out"
+}
+
+# Plots of one run from its JSON: ./tutorial.sh plots DIR (or a bench.json and a folder).
+plots() {
+  local json="${1:-results}" out="${2:-}"
+  [ -d "$json" ] && { out="${out:-$json}"; json="$json/bench.json"; }
+  out="${out:-$(dirname "$json")}"
+  log "plotting $json into $out/"
+  "$VENV/bin/python" scripts/plot_results.py "$json" --out "$out"
+}
+
+variant() {
+  [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
+  setup_venv
+  "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
 threads() {
-  build
+  quiet_build
   mkdir -p results
   local counts
   counts=$(seq -s, 1 "$(nproc)")
@@ -144,23 +194,42 @@ threads() {
 }
 
 scaling() {
-  build
+  quiet_build
   log "scaling over the beam series (a time budget per run; --help for the options)"
   "$VENV/bin/python" scripts/scaling.py --bench "$BUILD_DIR/fem_bench" --out results/scaling.json "$@"
   "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
 }
 
-docs() {
+regimes() {
   build
+  log "the regime sweep: every chapter, both poster-sized bodies, E over decades (scripts/regimes.py --help)"
+  "$VENV/bin/python" scripts/regimes.py --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
+}
+
+docs() {
+  quiet_build
   [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
   log "lesson tables (fem_lessons)"
   "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
+  "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
-  log "results tables and plots"
-  "$VENV/bin/python" scripts/update_docs.py --images docs/images
+  log "results: the run's JSON committed under docs/data/, tables and plots from it"
+  mkdir -p docs/data
+  for json in bench scaling viewer regimes threads; do
+    if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
+  done
+  "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
+  if [ -f docs/data/scaling.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+  fi
+  if [ -f docs/data/threads.json ]; then
+    "$VENV/bin/python" scripts/plot_results.py --threads docs/data/threads.json --out docs/images
+  fi
+  if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
+  "$VENV/bin/python" scripts/update_docs.py
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then
@@ -171,7 +240,7 @@ docs() {
 }
 
 sim() {
-  build
+  quiet_build
   log "simulating the cantilever on the poster-sized mesh (VTK frames in out/sim/)"
   "$BUILD_DIR/fem_sim" --out out/sim --every 4 "$@"
   log "rendering the frames to docs/images/cantilever.gif"
@@ -181,14 +250,14 @@ sim() {
 }
 
 viewer() {
-  build
+  quiet_build
   [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
   log "opening the viewer (space: pause, s: step, r: reset; drag the body with the mouse)"
   "$BUILD_DIR/fem_viewer" "$@"
 }
 
 viewer_bench() {
-  build
+  quiet_build
   [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
   log "the viewer's frame rate per chapter, headless (Xvfb, Mesa's software OpenGL)"
   "$VENV/bin/python" scripts/viewer_fps.py --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"
@@ -207,7 +276,10 @@ main() {
     build) build ;;
     test) run_tests "$@" ;;
     bench) bench "$@" ;;
+    plots) plots "$@" ;;
+    variant) variant "$@" ;;
     scaling) scaling "$@" ;;
+    regimes) regimes "$@" ;;
     threads) threads "$@" ;;
     docs) docs ;;
     sim) sim "$@" ;;

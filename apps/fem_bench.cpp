@@ -3,6 +3,9 @@
 // per-phase table (median ms, allocations per step) and writes it as JSON.
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
+#ifdef FEM_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#endif
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -54,6 +57,7 @@ Spread spread(std::vector<double> v) {
 struct ChapterResult {
   std::string chapter;
   std::string title;
+  std::string variant_of;                      // a student's variant: its original
   std::array<Spread, 6> ms;                    // per phase, milliseconds
   double allocations_per_step;                 // median over the measured steps
   std::array<long long, 6> phase_allocations;  // per phase, the last measured step
@@ -96,7 +100,8 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                       {},
                       {},
                       ChapterResult{threaded ? c->id + "@" + std::to_string(threads) : c->id,
-                                    c->title, {}, 0.0, {}, 0, 0.0, 0.0, 0, threads}});
+                                    c->title, c->variant_of, {}, 0.0, {}, 0, 0.0, 0.0, 0,
+                                    threads}});
   }
   const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
@@ -142,30 +147,39 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
 
 // The poster's solve table, on the same sequence of systems: the filtered systems of a
 // run of chapter 06 on the scene. Each solver solves every system from the same inputs;
-// "guess" solvers start from the previous system's solution.
+// "guess" solvers start from the previous system's solution (ours). The pattern never
+// changes, so the factorizing solvers analyse it once (analyzePattern, not timed) and
+// factorize every step: setup_ms is compute() or factorize(), solve_ms the solve.
 struct SolverResult {
   std::string name;
-  double median_ms = 0.0, iterations = 0.0, allocations_per_solve = 0.0;
+  double median_ms = 0.0, setup_ms = 0.0, solve_ms = 0.0, iterations = 0.0,
+         allocations_per_solve = 0.0;
 };
 
 std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& settings,
                                       int warmup, int steps) {
   using SparseMatrix = Eigen::SparseMatrix<double>;
+  using FullCg = Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper>;
   struct Samples {
-    std::vector<double> ms, iterations, allocations;
+    std::vector<double> total, setup, solve, iterations, allocations;
   };
-  const std::vector<std::string> names = {"eigen_cg",      "eigen_cg_guess", "pcg_ch06",
-                                          "eigen_cg_full", "eigen_cg_ichol", "eigen_ldlt"};
+  std::vector<std::string> names = {"eigen_cg",       "eigen_cg_guess",      "pcg_ch06",
+                                    "eigen_cg_full",  "eigen_cg_full_guess", "eigen_cg_ichol",
+                                    "eigen_ldlt"};
+#ifdef FEM_HAVE_CHOLMOD
+  names.push_back("cholmod_llt");
+  Eigen::CholmodSupernodalLLT<SparseMatrix> cholmod;
+#endif
   std::vector<Samples> samples(names.size());
   // One thread for these rows: with OpenMP compiled in, Eigen's Lower|Upper CG would use
   // every core (Eigen/src/SparseCore/SparseDenseProduct.h); the threaded rows follow.
   Eigen::setNbThreads(1);
   ch06::CustomPcgStepper stepper(scene, settings);
   State state = rest_state(scene);
-  Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x;
+  Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x, ours;
   ch06::PcgWorkspace work;
   Eigen::ConjugateGradient<SparseMatrix> cg;
-  Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper> cg_full;
+  FullCg cg_full;
   Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
                            Eigen::IncompleteCholesky<double>>
       cg_ichol;
@@ -182,54 +196,74 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
     stepper.step(state);
     const SparseMatrix& A = stepper.system_matrix();
     const Eigen::VectorXd& b = stepper.system_rhs();
-    if (offsets.empty()) offsets = ch06::diagonal_offsets(A);
-    const auto measure = [&](std::size_t i, const std::function<double()>& solve) {
+    if (offsets.empty()) {  // the pattern is the same for every system: analyse it once
+      offsets = ch06::diagonal_offsets(A);
+      cg_ichol.analyzePattern(A);
+      ldlt.analyzePattern(A);
+#ifdef FEM_HAVE_CHOLMOD
+      cholmod.analyzePattern(A);
+#endif
+    }
+    const auto measure = [&](std::size_t i, const std::function<void()>& setup,
+                             const std::function<double()>& solve) {
       alloc::Scope scope;
       const auto start = std::chrono::steady_clock::now();
+      setup();
+      const auto middle = std::chrono::steady_clock::now();
       const double iterations = solve();
-      const double ms =
-          1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const auto end = std::chrono::steady_clock::now();
       const long long allocations = scope.allocations();
       if (k < warmup) return;
-      samples[i].ms.push_back(ms);
+      const auto ms = [](auto a, auto b) {
+        return 1e3 * std::chrono::duration<double>(b - a).count();
+      };
+      samples[i].total.push_back(ms(start, end));
+      samples[i].setup.push_back(ms(start, middle));
+      samples[i].solve.push_back(ms(middle, end));
       samples[i].iterations.push_back(iterations);
       samples[i].allocations.push_back(static_cast<double>(allocations));
     };
-    measure(0, [&] {
-      cg.compute(A);
-      x = cg.solve(b);
-      return static_cast<double>(cg.iterations());
-    });
-    measure(1, [&] {
-      cg.compute(A);
-      x = cg.solveWithGuess(b, previous);
-      return static_cast<double>(cg.iterations());
-    });
-    measure(2, [&] {
+    const auto iterative = [&](auto& solver, bool guess) {
+      return [&solver, &b, &previous, &x, guess] {
+        if (guess)
+          x = solver.solveWithGuess(b, previous);
+        else
+          x = solver.solve(b);
+        if (solver.info() != Eigen::Success && solver.iterations() < solver.maxIterations())
+          throw std::runtime_error("the solve table: an Eigen CG failed");
+        return static_cast<double>(solver.iterations());
+      };
+    };
+    const auto direct = [&](auto& solver) {
+      return [&solver, &b, &x] {
+        x = solver.solve(b);
+        if (solver.info() != Eigen::Success)
+          throw std::runtime_error("the solve table: a direct solver failed");
+        return 0.0;
+      };
+    };
+    measure(0, [&] { cg.compute(A); }, iterative(cg, false));
+    measure(1, [&] { cg.compute(A); }, iterative(cg, true));
+    measure(2, [] {}, [&] {
       x = previous;
-      return static_cast<double>(
-          ch06::pcg_solve(A, b, scene.constraints, offsets, settings, work, x).iterations);
+      const double iterations =
+          ch06::pcg_solve(A, b, scene.constraints, offsets, settings, work, x).iterations;
+      ours = x;
+      return iterations;
     });
-    previous = x;  // the next system's guess: this one's solution
-    measure(3, [&] {
-      cg_full.compute(A);
-      x = cg_full.solve(b);
-      return static_cast<double>(cg_full.iterations());
-    });
-    measure(4, [&] {
-      cg_ichol.compute(A);
-      x = cg_ichol.solve(b);
-      return static_cast<double>(cg_ichol.iterations());
-    });
-    measure(5, [&] {
-      ldlt.compute(A);  // symbolic analysis and numeric factorization, every step
-      x = ldlt.solve(b);
-      return 0.0;
-    });
+    measure(3, [&] { cg_full.compute(A); }, iterative(cg_full, false));
+    measure(4, [&] { cg_full.compute(A); }, iterative(cg_full, true));
+    measure(5, [&] { cg_ichol.factorize(A); }, iterative(cg_ichol, true));
+    measure(6, [&] { ldlt.factorize(A); }, direct(ldlt));
+#ifdef FEM_HAVE_CHOLMOD
+    measure(7, [&] { cholmod.factorize(A); }, direct(cholmod));
+#endif
+    previous = ours;  // the next system's guess: this one's solution
   }
   std::vector<SolverResult> out;
   for (std::size_t i = 0; i < names.size(); ++i)
-    out.push_back({names[i], spread(samples[i].ms).median, spread(samples[i].iterations).median,
+    out.push_back({names[i], spread(samples[i].total).median, spread(samples[i].setup).median,
+                   spread(samples[i].solve).median, spread(samples[i].iterations).median,
                    spread(samples[i].allocations).median});
   return out;
 }
@@ -291,25 +325,33 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
   }
   Eigen::setNbThreads(1);
   std::vector<SolverResult> out;
-  for (const Row& row : rows)
-    out.push_back({row.name, spread(row.ms).median, spread(row.iterations).median,
-                   spread(row.allocations).median});
+  for (const Row& row : rows) {
+    SolverResult r;
+    r.name = row.name;
+    r.median_ms = r.solve_ms = spread(row.ms).median;  // with compute(): a diagonal, microseconds
+    r.iterations = spread(row.iterations).median;
+    r.allocations_per_solve = spread(row.allocations).median;
+    out.push_back(r);
+  }
   return out;
 }
 
 void print_solvers(const std::vector<SolverResult>& solvers) {
   std::cout << "\nsolve table (the filtered systems of chapter 06's run; same tolerance)\n"
-            << std::left << std::setw(18) << "solver" << std::right << std::setw(12) << "median ms"
-            << std::setw(12) << "iterations" << std::setw(14) << "allocs/solve" << std::setw(14)
+            << std::left << std::setw(21) << "solver" << std::right << std::setw(11) << "median ms"
+            << std::setw(10) << "setup" << std::setw(10) << "solve" << std::setw(12)
+            << "iterations" << std::setw(14) << "allocs/solve" << std::setw(14)
             << "vs eigen_cg\n";
   for (const auto& s : solvers)
-    std::cout << std::left << std::setw(18) << s.name << std::right << std::fixed
-              << std::setprecision(3) << std::setw(12) << s.median_ms << std::setprecision(0)
+    std::cout << std::left << std::setw(21) << s.name << std::right << std::fixed
+              << std::setprecision(3) << std::setw(11) << s.median_ms << std::setw(10)
+              << s.setup_ms << std::setw(10) << s.solve_ms << std::setprecision(0)
               << std::setw(12) << s.iterations << std::setw(14) << s.allocations_per_solve
               << std::setprecision(2) << std::setw(12) << solvers.front().median_ms / s.median_ms
               << "x" << std::defaultfloat << "\n";
-  std::cout << "(iterations: Eigen counts the products of full iterations, the last one excluded;"
-               " pcg_ch06 counts every product)\n";
+  std::cout << "(setup: compute() or factorize() after one analyzePattern; iterations: Eigen counts"
+               " the products of full iterations, the last one excluded; pcg_ch06 counts every"
+               " product)\n";
   if (solvers.back().name.find('@') != std::string::npos)
     std::cout << "(rows NAME@N: chapter 09's systems, the same filtered systems assembled in "
                  "another order, on N threads)\n";
@@ -388,7 +430,7 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
   for (std::size_t i = 0; i < results.size(); ++i) {
     const ChapterResult& r = results[i];
     out << "    {\"chapter\": " << json_string(r.chapter) << ", \"title\": " << json_string(r.title)
-        << ",\n"
+        << (r.variant_of.empty() ? "" : ", \"variant_of\": " + json_string(r.variant_of)) << ",\n"
         << "     \"median_ms\": " << spread_json(r.ms, &Spread::median) << ",\n"
         << "     \"min_ms\": " << spread_json(r.ms, &Spread::min) << ",\n"
         << "     \"q1_ms\": " << spread_json(r.ms, &Spread::q1) << ",\n"
@@ -409,6 +451,7 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
     for (std::size_t i = 0; i < solvers.size(); ++i)
       out << "    {\"name\": " << json_string(solvers[i].name)
           << ", \"median_ms\": " << solvers[i].median_ms
+          << ", \"setup_ms\": " << solvers[i].setup_ms << ", \"solve_ms\": " << solvers[i].solve_ms
           << ", \"iterations\": " << solvers[i].iterations
           << ", \"allocations_per_solve\": " << solvers[i].allocations_per_solve << "}"
           << (i + 1 < solvers.size() ? "," : "") << "\n";
@@ -498,19 +541,28 @@ std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
   return out;
 }
 
+// --json FILE, else DIR/bench.json of --out DIR; "" when both are empty.
+std::string json_path(const ArgParser& args) {
+  if (!args.get("json").empty()) return args.get("json");
+  if (args.get("out").empty()) return "";
+  return (std::filesystem::path(args.get("out")) / "bench.json").string();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   ArgParser args("fem_bench",
                  "Benchmarks chapters on one scene: per-phase median ms, allocations per step,\n"
-                 "CG iterations; prints a table and writes JSON (schema in README.md).");
+                 "CG iterations; prints a table and writes JSON (schema in README.md) into the\n"
+                 "run's folder (--out), where ./tutorial.sh bench also writes the plots.");
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
   args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
   args.option("warmup", "N", "unmeasured steps first, >= 0", "10");
-  args.option("json", "FILE", "where to write the results ('' for nowhere)", "results/bench.json");
-  args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT)");
+  args.option("out", "DIR", "the run's folder: writes DIR/bench.json ('' for nowhere)", "results");
+  args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
+  args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
   args.option("threads", "LIST",
               "thread counts for the parallel chapters (09 on), comma-separated (default: 1 and "
               "OMP_NUM_THREADS, else 1 and all " +
@@ -554,9 +606,11 @@ int main(int argc, char** argv) {
       std::cout << " done\n";
       print_solvers(solvers);
     }
-    if (const std::string& path = args.get("json"); !path.empty()) {
+    if (const std::string path = json_path(args); !path.empty()) {
+      const bool replaced = std::filesystem::exists(path);
       write_json(path, scene, solver, warmup, steps, results, solvers, load_before);
-      std::cout << "\nwrote " << path << "\n";
+      std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there)" : "")
+                << "\n";
     }
   } catch (const UsageError& e) {
     std::cerr << "fem_bench: " << e.what() << " (see fem_bench --help)\n";

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
   add_thread_option(args);
-  args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", chapters().back().id);
+  args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", latest_chapter().id);
   args.option("steps", "N", "number of time steps, > 0", "200");
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
   args.option("out", "DIR", "directory for the .vtu frames and the .pvd series", "out/sim");

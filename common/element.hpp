@@ -22,7 +22,7 @@ Lame lame_from_young_poisson(double youngs_modulus, double poisson_ratio);
 struct ElementRest {
   Eigen::Matrix3d Dm_inv;  // inverse of Dm = [X1-X0, X2-X0, X3-X0]
   double volume;           // rest volume |det Dm| / 6
-  Matrix12d K0;            // rest stiffness: 4x4 blocks of 3x3, K0 * u = internal force of u
+  Matrix12d K0;            // rest stiffness, 4x4 blocks of 3x3: f_e = -R K0 (R^T x_e - X_e)
   Vector12d X;             // rest positions, stacked
 };
 

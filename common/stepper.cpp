@@ -49,6 +49,12 @@ const char* divergence(const State& state, const StepProfile& profile) {
   if (!state.x.allFinite() || !state.v.allFinite()) return "non-finite positions or velocities";
   if (!std::isfinite(profile.relative_residual))
     return "the linear solve's residual is not finite: the system overflows";
+  // Above 1, ||b - A dv|| > ||b||: the solve's answer is further from solving the system
+  // than dv = 0, not a step at all (near-incompressible material, nu -> 0.5, does this to CG
+  // at its iteration cap). Below 1 a capped solve is an inexact step: warned and counted.
+  if (!profile.converged && profile.relative_residual > 1.0)
+    return "the linear solve did not converge: at the iteration cap its relative residual is "
+           "above 1, worse than no solve (a near-incompressible nu? raise --max-iters)";
   return nullptr;
 }
 

@@ -95,9 +95,11 @@ void report_if_not_converged(const StepProfile& profile, const SolverSettings& s
                              const char* chapter, bool& already_warned);
 
 // Why the last step cannot be trusted, or nullptr when it can: non-finite positions or
-// velocities, or a solve whose residual is not finite. The second happens when the system
+// velocities, a solve whose residual is not finite, or a solve stopped at the iteration cap
+// with a relative residual above 1 (worse than dv = 0). The second happens when the system
 // overflows (an absurd E or dt): CG then stops at once and leaves the state finite but
-// frozen, which a check of the positions alone would let pass silently.
+// frozen, which a check of the positions alone would let pass silently. The third happens
+// with a near-incompressible material (nu = 0.4999999): every step ran to the cap, finite.
 const char* divergence(const State& state, const StepProfile& profile);
 
 }  // namespace fem

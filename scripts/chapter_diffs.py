@@ -15,7 +15,10 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def chapter_dirs(root):
-    return sorted(d for d in (root / "chapters").iterdir() if d.is_dir() and d.name[:2].isdigit())
+    """The course's chapters: a student's variant (./tutorial.sh variant, marked by its
+    variant_of file) is no lesson, and its diff against the original is the student's own."""
+    return sorted(d for d in (root / "chapters").iterdir()
+                  if d.is_dir() and d.name[:2].isdigit() and not (d / "variant_of").exists())
 
 
 def diff(previous, current, root):

@@ -17,7 +17,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # noqa: E402
-                            POSTER_SOLVE_MS, ResultsError, chapter_dir, die, footer, load_checked)
+                            POSTER_SOLVE_MS, ResultsError, chapter_color, chapter_dir,
+                            comparable_to_poster, die, footer, load_checked, run_label)
 
 
 def finish(fig, data, path):
@@ -32,6 +33,10 @@ def chapter_labels(chapters):
     return [c["chapter"] for c in chapters]
 
 
+def color(c):
+    return chapter_color(c["chapter"], c.get("variant_of", ""))
+
+
 def plot_phases(data, out):
     chapters = data["chapters"]
     phases = ["forces"] + PHASES
@@ -43,11 +48,12 @@ def plot_phases(data, out):
         lo = med - np.array([c["q1_ms"][p] for p in phases])
         hi = np.array([c["q3_ms"][p] for p in phases]) - med
         ax.bar(x + (i - (len(chapters) - 1) / 2) * width, np.maximum(med, 1e-4), width,
-               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"])
+               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"],
+               color=color(c))
     ax.set_yscale("log")
     ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel("median time per step [ms] (log; bars: quartiles)")
-    ax.set_title("Time per phase of one step, chapter by chapter")
+    ax.set_title(f"Time per phase of one step, chapter by chapter ({run_label(data)})")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "phases.png")
@@ -61,28 +67,32 @@ def plot_speedup(data, out):
         ax.text(0.5, 0.5, "only one chapter measured: no speedup to show" if base else
                 f"no {BASELINE} in the results: no baseline", ha="center", va="center")
         ax.set_axis_off()
-        ax.set_title("Speedup over chapter 01")
+        ax.set_title(f"Speedup over chapter 01 ({run_label(data)})")
         finish(fig, data, out / "speedup.png")
         return
     others = [c for c in chapters if c is not base]
     # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
     phases = ["forces"] + PHASES
+    poster = comparable_to_poster(data)
+    bars = len(others) + (1 if poster else 0)
     x = np.arange(len(phases))
-    width = 0.8 / (len(others) + 1)
+    width = 0.8 / bars
     for i, c in enumerate(others):
         # A phase a chapter no longer has (chapter 08's df/dx, fused into its element pass) gets
         # no bar rather than an infinite one.
         s = [base["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
              for p in phases]
-        ax.bar(x + (i - len(others) / 2) * width, s, width, label=c["chapter"])
-    poster = [POSTER_SPEEDUPS.get(p, np.nan) for p in phases]
-    ax.bar(x + (len(others) - len(others) / 2) * width, poster, width, color="none",
-           edgecolor="black", hatch="//", label="poster (optimized vs naive)")
+        ax.bar(x + (i - (bars - 1) / 2) * width, s, width, label=c["chapter"], color=color(c))
+    if poster:
+        ax.bar(x + (len(others) - (bars - 1) / 2) * width,
+               [POSTER_SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
+               edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
     ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
-    ax.set_title("Speedup per phase over the naive stepper, beside the poster's")
+    ax.set_title("Speedup per phase over the naive stepper" + (", beside the poster's" if poster else "")
+                 + f" ({run_label(data)})")
     ax.legend(fontsize=8, ncol=2)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "speedup.png")
@@ -92,14 +102,15 @@ def plot_allocations(data, out):
     chapters = data["chapters"]
     counts = [c["allocations_per_step"] for c in chapters]
     fig, ax = plt.subplots(figsize=(9, 4.5))
-    bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts], color="tab:red")
+    bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts],
+                  color=[color(c) for c in chapters])
     for bar, a in zip(bars, counts):
         ax.annotate(f"{a:g}", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
                     ha="center", va="bottom", fontsize=9)
     ax.set_yscale("log")
     ax.set_ylim(0.3, max(counts + [1]) * 3)
     ax.set_ylabel("heap allocations per step (log; 0 drawn at 0.5)")
-    ax.set_title("Heap allocations per step (after the first)")
+    ax.set_title(f"Heap allocations per step, after the first ({run_label(data)})")
     ax.tick_params(axis="x", rotation=20)
     finish(fig, data, out / "allocations.png")
 
@@ -110,19 +121,26 @@ def plot_solvers(data, out):
         return
     names = [s["name"] for s in solvers]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
-    ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
-    poster = [POSTER_SOLVE_MS.get(n) for n in names]
-    ys = [i for i, p in enumerate(poster) if p is not None]
-    ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
+    if all("setup_ms" in s and "solve_ms" in s for s in solvers):
+        setup = [s["setup_ms"] for s in solvers]
+        ax1.barh(names, setup, color="tab:orange", label="setup: compute() / factorize()")
+        ax1.barh(names, [s["solve_ms"] for s in solvers], left=setup, color="tab:blue",
+                 label="solve")
+    else:
+        ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
+    if comparable_to_poster(data):  # absolute times compare only on the poster's run
+        poster = [POSTER_SOLVE_MS.get(n) for n in names]
+        ys = [i for i, p in enumerate(poster) if p is not None]
+        ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
+    ax1.legend(fontsize=8)
     ax1.invert_yaxis()
     ax1.set_xlabel("median time per solve [ms]")
     ax1.set_title("Time per solve")
-    ax1.legend(fontsize=8)
     ax2.barh(names, [s["iterations"] for s in solvers], color="tab:green")
     ax2.invert_yaxis()
     ax2.set_xlabel("CG iterations per solve (median; 0 for a direct solver)")
     ax2.set_title("Iterations")
-    fig.suptitle("The solve table: the same systems, the same tolerance")
+    fig.suptitle(f"The solve table: the same systems, the same tolerance ({run_label(data)})")
     finish(fig, data, out / "solvers.png")
 
 
@@ -150,7 +168,7 @@ def plot_scaling(data, out):
         for c in chapters:
             pts = sorted((r["nodes"], r[key]) for r in runs if r["chapter"] == c)
             xs, ys = zip(*pts)
-            line, = ax.plot(xs, ys, marker="o", ms=3)
+            line, = ax.plot(xs, ys, marker="o", ms=3, color=chapter_color(c))
             if c in stopped:
                 ax.scatter([xs[-1]], [ys[-1]], marker="x", s=70, color=line.get_color(), zorder=3)
             ends.append((xs[-1], ys[-1], c + (" (stopped)" if c in stopped else ""), line.get_color()))
@@ -166,7 +184,7 @@ def plot_scaling(data, out):
         ax.set_ylabel(f"median {title} time per step [ms] (log)")
         ax.set_title(f"{title.capitalize()} against mesh size")
         ax.grid(which="both", alpha=0.3)
-    fig.suptitle(f"Scaling over the beam series (x: the next size went over the "
+    fig.suptitle(f"Scaling over the beam series, {data['scene']} scene (x: the next size went over the "
                  f"{data.get('budget_seconds', '?')} s budget per run)", fontsize=10)
     finish(fig, data, out / "scaling.png")
 
@@ -234,6 +252,8 @@ def main():
     try:
         if args.bench:
             data = load_checked(args.bench)
+            print(f"plots of {args.bench}: {run_label(data)}, "
+                  f"{', '.join(c['chapter'] for c in data['chapters'])}")
             plot_phases(data, out)
             plot_speedup(data, out)
             plot_allocations(data, out)

@@ -21,6 +21,33 @@ PHASE_LABELS = {
 POSTER_SPEEDUPS = {"dfdx": 5.487, "compose": 21.358, "constraints": 218.79, "step": 9.849}
 POSTER_SOLVE_MS = {"eigen_cg": 7.1, "eigen_cg_guess": 4.39, "pcg_ch06": 1.68}
 BASELINE = "01_naive"
+# The poster's numbers were measured on the cantilever on a mesh of the poster's size: they
+# are drawn beside a run only when the run is that one (any other mesh or scene would compare
+# unlike with unlike).
+POSTER_MESH, POSTER_SCENE = "plate_poster.msh", "cantilever"
+
+
+def comparable_to_poster(data):
+    return data.get("mesh", {}).get("file") == POSTER_MESH and data.get("scene") == POSTER_SCENE
+
+
+def run_label(data):
+    """What a plot's title says about the run: the scene and the mesh."""
+    mesh = data.get("mesh")
+    where = f"{mesh['file']}, {mesh['nodes']} nodes" if mesh else "the beam series"
+    return f"{data['scene']} scene, {where}"
+
+
+def chapter_color(chapter, variant_of=""):
+    """One colour per chapter in every plot: matplotlib's tab20 pairs, the dark one for the
+    chapter NN of the course, the light one of the same hue for a student's variant of it."""
+    import matplotlib
+    palette = matplotlib.colormaps["tab20"].colors
+    try:
+        number = int(chapter[:2])
+    except ValueError:
+        return "0.4"
+    return palette[(2 * (number - 1)) % 20 + (1 if variant_of else 0)]
 
 
 class ResultsError(Exception):
@@ -102,6 +129,9 @@ def validate_bench(data):
         need(s, "name", str, where)
         for key in ("median_ms", "iterations", "allocations_per_solve"):
             need(s, key, float, where)
+        for key in ("setup_ms", "solve_ms"):  # absent in results written before they existed
+            if isinstance(s, dict) and key in s:
+                need(s, key, float, where)
     return problems
 
 

@@ -325,7 +325,7 @@ int main(int argc, char** argv) {
   add_solver_options(args);
   add_thread_option(args);
   args.option("chapter", "NAME", "stepper to start with (switch in the panel)",
-              chapters().back().id);
+              latest_chapter().id);
   args.option("frames", "N", "stop after N frames (0: run until the window is closed)", "0");
   args.option("width", "PIXELS", "window width", "1280");
   args.option("height", "PIXELS", "window height", "800");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "apps/viewer/markers.hpp"
 #include "chapters/registry.hpp"
 #include "common/threads.hpp"
 
@@ -49,8 +50,10 @@ void phase_bars(const Session& session) {
     history[count] = static_cast<float>(1e3 * p.step.seconds);
     highest = std::max(highest, history[count++]);
   }
-  ImGui::PlotLines("step [ms]", history, count, 0, nullptr, 0.0f, 1.2f * highest + 1e-3f,
-                   ImVec2(180, 50));
+  // The graph's scale: 0 at the bottom, `top` at the top.
+  const float top = 1.2f * highest + 1e-3f;
+  ImGui::Text("step time of the last %d steps (0 to %.2f ms)", count, top);
+  ImGui::PlotLines("##step time", history, count, 0, nullptr, 0.0f, top, ImVec2(kPanelWidth - 20, 40));
   ImGui::Text("CG: %d iterations, residual %.1e", session.last_profile().cg_iterations,
               session.last_profile().relative_residual);
   if (!session.last_profile().converged)
@@ -64,11 +67,31 @@ void clock_controls(PanelState& state) {
   ImGui::SameLine();
   if (ImGui::Button("reset (r)")) state.reset = true;
   int mode = state.mode == StepMode::OneStepPerFrame ? 0 : 1;
-  ImGui::RadioButton("real-time: one step per frame", &mode, 0);
-  ImGui::RadioButton("fixed dt: simulated time = wall time", &mode, 1);
+  ImGui::RadioButton("one step per frame", &mode, 0);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("one step of dt per drawn frame, as fast as the stepper goes");
+  ImGui::RadioButton("keep up with the wall clock", &mode, 1);
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("as many steps of dt per frame as the wall clock asks (at most 8)");
   state.mode = mode == 0 ? StepMode::OneStepPerFrame : StepMode::FixedDt;
   if (state.mode == StepMode::FixedDt && state.behind_steps > 0)
     ImGui::TextColored(ImVec4(1, 0.7f, 0.2f, 1), "behind the wall clock: the steps are too slow");
+}
+
+// What the coloured points on the body are, in the renderer's colours.
+void legend(const Scene& scene) {
+  const auto entry = [](const Marker& m) {
+    ImGui::ColorButton(m.meaning, ImVec4(m.rgb[0], m.rgb[1], m.rgb[2], 1.0f),
+                       ImGuiColorEditFlags_NoTooltip, ImVec2(10, 10));
+    ImGui::SameLine();
+    ImGui::TextUnformatted(m.meaning);
+  };
+  bool shown[3] = {};  // by Kind: the scene's kinds only (the cantilever has fixed nodes)
+  for (const NodeConstraint& c : scene.constraints) shown[static_cast<std::size_t>(c.kind)] = true;
+  for (const auto kind :
+       {NodeConstraint::Kind::Fixed, NodeConstraint::Kind::Line, NodeConstraint::Kind::Plane})
+    if (shown[static_cast<std::size_t>(kind)]) entry(constraint_marker(kind));
+  entry(kSpringMarker);
 }
 
 bool slider(const char* label, double& value, double lo, double hi, bool logarithmic) {
@@ -125,6 +148,7 @@ void draw_panel(const Session& session, double frames_per_second, PanelState& st
   clock_controls(state);
   if (ImGui::CollapsingHeader("scene, material, clock")) scene_controls(session, state);
   ImGui::Separator();
+  legend(session.scene());
   ImGui::TextDisabled("drag the body: pull it; drag elsewhere: orbit");
   ImGui::TextDisabled("right/middle drag: pan; wheel: zoom");
   const std::string& warning = state.error.empty() ? session.message() : state.error;

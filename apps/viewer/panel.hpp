@@ -11,8 +11,8 @@
 namespace fem::viewer {
 
 enum class StepMode {
-  OneStepPerFrame,  // "real-time": one step of dt per drawn frame, as fast as the stepper goes
-  FixedDt,          // simulated time follows the wall clock: as many steps of dt as it takes
+  OneStepPerFrame,  // one step of dt per drawn frame, as fast as the stepper goes
+  FixedDt,          // keeps up with the wall clock: as many steps of dt as it takes
 };
 
 // What the user can change from the panel, kept between frames.

@@ -6,6 +6,8 @@
 
 #include <stdexcept>
 
+#include "apps/viewer/markers.hpp"
+
 namespace fem::viewer {
 
 namespace {
@@ -134,16 +136,8 @@ void set_matrix(unsigned program, const char* name, const Eigen::Matrix4f& m) {
   glUniformMatrix4fv(glGetUniformLocation(program, name), 1, GL_FALSE, m.data());
 }
 
-Eigen::Vector3f colour_of(NodeConstraint::Kind kind) {
-  switch (kind) {
-    case NodeConstraint::Kind::Fixed:
-      return {0.85f, 0.15f, 0.15f};  // red: S_i = 0
-    case NodeConstraint::Kind::Line:
-      return {0.95f, 0.55f, 0.10f};  // orange: one free direction
-    case NodeConstraint::Kind::Plane:
-      return {0.20f, 0.45f, 0.90f};  // blue: two free directions
-  }
-  return {1.0f, 1.0f, 1.0f};
+Eigen::Vector3f colour(const Marker& marker) {
+  return {marker.rgb[0], marker.rgb[1], marker.rgb[2]};
 }
 
 }  // namespace
@@ -182,7 +176,7 @@ void Renderer::set_scene(const Scene& scene) {
   constraint_colours_.clear();
   for (const NodeConstraint& c : scene.constraints) {
     constrained_nodes_.push_back(c.node);
-    constraint_colours_.push_back(colour_of(c.kind));
+    constraint_colours_.push_back(colour(constraint_marker(c.kind)));
   }
 
   // The floor: the plane the sliding scene rests on; under the cantilever, a body length
@@ -229,10 +223,10 @@ void Renderer::upload_points(const State& state, const std::optional<Grab>& grab
          constraint_colours_[k]);
   points_.count = static_cast<int>(constrained_nodes_.size());
   if (grab) {
-    const Eigen::Vector3f yellow(1.0f, 0.85f, 0.1f);
+    const Eigen::Vector3f spring = colour(kSpringMarker);
     const Eigen::Vector3f node = state.x.segment<3>(3 * grab->node).cast<float>();
-    push(scratch_, node, yellow);
-    push(scratch_, grab->target.cast<float>(), yellow);
+    push(scratch_, node, spring);
+    push(scratch_, grab->target.cast<float>(), spring);
     points_.count += 2;
   }
   upload(points_.vbo, scratch_);

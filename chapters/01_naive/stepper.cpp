@@ -1,11 +1,10 @@
 // Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Written the way Eigen's documentation suggests, without thinking about memory.
 #include "chapters/01_naive/stepper.hpp"
 
-#include <iostream>
 
 namespace fem::ch01 {
 

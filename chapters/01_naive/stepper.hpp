@@ -40,7 +40,7 @@ class NaiveStepper final : public Stepper {
   Eigen::SparseMatrix<double> M_;           // lumped mass, a diagonal sparse matrix
   Eigen::SparseMatrix<double> dfdx_;        // pattern of the mesh connectivity, allocated once
   Eigen::SparseMatrix<double> A_;           // M - h df/dv - h^2 df/dx
-  Eigen::VectorXd b_;                       // h (f + h df/dx v)
+  Eigen::VectorXd b_;                       // h (f + f_ext + df/dv v + h df/dx v)
   Eigen::SparseMatrix<double> S_;           // the constraint filter, 3x3 blocks S_i on the diagonal
   Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
   Eigen::SparseMatrix<double> filtered_A_;  // S A S^T + I - S

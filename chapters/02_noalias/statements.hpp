@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "chapters/01_naive/stepper.hpp"
+#include "common/model.hpp"
 #include "common/alloc_counter.hpp"
 
 namespace fem::ch02 {
@@ -23,14 +24,19 @@ struct StatementCount {
 // The operands of the step's vector statements, with the sizes and patterns of a real
 // step of chapter 01 on the given scene.
 struct StatementOperands {
-  explicit StatementOperands(const Scene& scene) {
+  explicit StatementOperands(const Scene& scene)
+      : h(scene.dt), alpha(scene.damping.alpha), beta(scene.damping.beta) {
     ch01::NaiveStepper naive(scene, {});
     State state = rest_state(scene);
     naive.step(state);
     const int n = static_cast<int>(state.x.size());
     dfdx = naive.dfdx();
     A = naive.system_matrix();
-    dfdv = 0.005 * dfdx;
+    mass = Model(scene).lumped_mass;
+    M.resize(n, n);
+    M.setIdentity();
+    M.diagonal() = mass;
+    dfdv = -alpha * M + beta * dfdx;  // Rayleigh damping with the scene's alpha and beta
     S.resize(n, n);
     S.setIdentity();
     v = state.v;
@@ -42,12 +48,13 @@ struct StatementOperands {
     if (sparse_f.nonZeros() == 0) sparse_f.coeffRef(0) = 1.0;
     cg.compute(A);
   }
-  Eigen::SparseMatrix<double> dfdx, dfdv, A, S;
+  // The scene's time step and damping: the statements compute what the steppers compute.
+  double h, alpha, beta;
+  Eigen::SparseMatrix<double> dfdx, M, dfdv, A, S;
   Eigen::SparseVector<double> sparse_f;
-  Eigen::VectorXd v, f, z, b, tmp, rhs, dv, filtered_b;
+  Eigen::VectorXd mass, v, f, z, b, tmp, rhs, dv, filtered_b;
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>> cg;
   std::vector<Eigen::Triplet<double>> triplets;  // reused: keeps its capacity
-  double h = 0.01, beta = 0.005;
 };
 
 // Counts the allocations of one run of `statement` (run once before, so that vectors
@@ -66,11 +73,11 @@ inline std::vector<StatementCount> count_statements(const Scene& scene) {
   // Plain names, so that the measured code reads as in the steppers.
   const auto &dfdx = o.dfdx, &dfdv = o.dfdv, &A = o.A, &S = o.S;
   const auto& sparse_f = o.sparse_f;
-  const auto &v = o.v, &f = o.f, &z = o.z;
+  const auto &mass = o.mass, &v = o.v, &f = o.f, &z = o.z;
   auto &b = o.b, &tmp = o.tmp, &rhs = o.rhs, &dv = o.dv, &filtered_b = o.filtered_b;
   auto& cg = o.cg;
   auto& triplets = o.triplets;
-  const double h = o.h, beta = o.beta;
+  const double h = o.h, alpha = o.alpha, beta = o.beta;
   const int n = static_cast<int>(v.size());
   std::vector<StatementCount> out;
   const auto add = [&out](const char* before_code, const std::function<void()>& before,
@@ -82,7 +89,8 @@ inline std::vector<StatementCount> count_statements(const Scene& scene) {
       FEM_STATEMENT(tmp = h * v; tmp += sparse_f; rhs.noalias() += h * (dfdx * tmp)));
   // The right-hand side of the step.
   add(FEM_STATEMENT(b = h * (f + dfdv * v + h * (dfdx * v))),
-      FEM_STATEMENT(tmp = (h + beta) * v; b.noalias() = h * (dfdx * tmp); b += h * f));
+      FEM_STATEMENT(tmp = (h + beta) * v; b.noalias() = h * (dfdx * tmp);
+                    b += h * f - (h * alpha) * mass.cwiseProduct(v)));
   // The filtered right-hand side.
   add(FEM_STATEMENT(filtered_b = S * (b - A * z)),
       FEM_STATEMENT(tmp = b; tmp.noalias() -= A * z; filtered_b.noalias() = S * tmp));

@@ -1,11 +1,10 @@
-// Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+// Chapter 02: one linearized backward Euler step (Baraff & Witkin 1998),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Chapter 02 changes only the vector statements: none of them allocates any more.
 #include "chapters/02_noalias/stepper.hpp"
 
-#include <iostream>
 
 namespace fem::ch02 {
 
@@ -94,8 +93,8 @@ void NoAliasStepper::compose_system(const State& state) {
   // product into a hidden temporary first, because Eigen assumes b could appear on the
   // right; noalias() promises it does not, and the product is accumulated into b.
   // (noalias() only matters for products: coefficient-wise expressions never allocate.)
-  tmp_ = (h + beta) * state.v;
-  b_.noalias() = h * (dfdx_ * tmp_);
+  scaled_v_ = (h + beta) * state.v;
+  b_.noalias() = h * (dfdx_ * scaled_v_);
   b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
   b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary
 }
@@ -125,10 +124,10 @@ void NoAliasStepper::apply_constraints(const State& state) {
   const SparseMatrix S_transpose = S_.transpose();  // S^T is row-major: store it to mix it
   filtered_A_ = S_ * A_ * S_transpose + (identity_ - S_);
   // S (b - A z) as written evaluates A z into a temporary, then b - A z into another,
-  // before the product with S: reuse tmp_ and give every product its own noalias().
-  tmp_ = b_;
-  tmp_.noalias() -= A_ * z_;
-  filtered_b_.noalias() = S_ * tmp_;
+  // before the product with S: a reused vector, and every product its own noalias().
+  unfiltered_rhs_ = b_;
+  unfiltered_rhs_.noalias() -= A_ * z_;
+  filtered_b_.noalias() = S_ * unfiltered_rhs_;
 }
 
 void NoAliasStepper::solve() {

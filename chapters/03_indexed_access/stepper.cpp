@@ -1,5 +1,5 @@
-// Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+// Chapter 03: one linearized backward Euler step (Baraff & Witkin 1998),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Chapter 03 changes only how df/dx is filled: through a table of value offsets.
@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cassert>
-#include <iostream>
 #include <stdexcept>
 
 namespace fem::ch03 {
@@ -88,7 +87,8 @@ void IndexedAccessStepper::build_block_offsets() {
     }
   }
   if (!block_offsets_match_pattern())
-    throw std::logic_error("03_indexed_access: the block offset table does not match the pattern");
+    throw std::logic_error(
+        "03_indexed_access: the block offset table does not match the pattern");
 }
 
 bool IndexedAccessStepper::block_offsets_match_pattern() const {
@@ -143,8 +143,8 @@ void IndexedAccessStepper::compose_system(const State& state) {
   // product into a hidden temporary first, because Eigen assumes b could appear on the
   // right; noalias() promises it does not, and the product is accumulated into b.
   // (noalias() only matters for products: coefficient-wise expressions never allocate.)
-  tmp_ = (h + beta) * state.v;
-  b_.noalias() = h * (dfdx_ * tmp_);
+  scaled_v_ = (h + beta) * state.v;
+  b_.noalias() = h * (dfdx_ * scaled_v_);
   b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
   b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary
 }
@@ -174,10 +174,10 @@ void IndexedAccessStepper::apply_constraints(const State& state) {
   const SparseMatrix S_transpose = S_.transpose();  // S^T is row-major: store it to mix it
   filtered_A_ = S_ * A_ * S_transpose + (identity_ - S_);
   // S (b - A z) as written evaluates A z into a temporary, then b - A z into another,
-  // before the product with S: reuse tmp_ and give every product its own noalias().
-  tmp_ = b_;
-  tmp_.noalias() -= A_ * z_;
-  filtered_b_.noalias() = S_ * tmp_;
+  // before the product with S: a reused vector, and every product its own noalias().
+  unfiltered_rhs_ = b_;
+  unfiltered_rhs_.noalias() -= A_ * z_;
+  filtered_b_.noalias() = S_ * unfiltered_rhs_;
 }
 
 void IndexedAccessStepper::solve() {

@@ -49,7 +49,7 @@ class IndexedAccessStepper final : public Stepper {
   Eigen::SparseMatrix<double> dfdx_;         // pattern of the mesh connectivity, allocated once
   std::vector<BlockOffsets> block_offsets_;  // per element, built once with the pattern
   Eigen::SparseMatrix<double> A_;            // M - h df/dv - h^2 df/dx
-  Eigen::VectorXd b_;                        // h (f + h df/dx v)
+  Eigen::VectorXd b_;                        // h (f + f_ext + df/dv v + h df/dx v)
   Eigen::SparseMatrix<double> S_;           // the constraint filter, 3x3 blocks S_i on the diagonal
   Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
   Eigen::SparseMatrix<double> filtered_A_;  // S A S^T + I - S
@@ -57,7 +57,8 @@ class IndexedAccessStepper final : public Stepper {
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;  // (h + beta) v, then b - A z
+  Eigen::VectorXd scaled_v_;        // (h + beta) v, the vector df/dx multiplies in b
+  Eigen::VectorXd unfiltered_rhs_;  // b - A z, before the product with S
   std::vector<Eigen::Triplet<double>> s_triplets_;
   std::vector<bool> constrained_;
   Eigen::SparseMatrix<double> identity_;

@@ -1,5 +1,5 @@
-// Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+// Chapter 05: one linearized backward Euler step (Baraff & Witkin 1998),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Chapter 05 changes only how the constraints are applied: in place, no S.
@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cassert>
-#include <iostream>
 #include <stdexcept>
 
 namespace fem::ch05 {
@@ -91,7 +90,8 @@ void InplaceConstraintsStepper::build_block_offsets() {
     }
   }
   if (!block_offsets_match_pattern())
-    throw std::logic_error("03_indexed_access: the block offset table does not match the pattern");
+    throw std::logic_error(
+        "05_inplace_constraints: the block offset table does not match the pattern");
 }
 
 bool InplaceConstraintsStepper::block_offsets_match_pattern() const {
@@ -149,8 +149,8 @@ void InplaceConstraintsStepper::compose_system(const State& state) {
   for (int k = 0; k < model_.dofs; ++k)
     A[diagonal_offsets_[k]] += mass_factor * model_.lumped_mass[k];
   // b = h (f - alpha M v) + h df/dx ((h + beta) v), one product with a dense vector.
-  tmp_ = (h + beta) * state.v;
-  b_.noalias() = h * (dfdx_ * tmp_);
+  scaled_v_ = (h + beta) * state.v;
+  b_.noalias() = h * (dfdx_ * scaled_v_);
   b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
   b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary
 }

@@ -1,5 +1,5 @@
-// Chapter 01: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+// Chapter 06: one linearized backward Euler step (Baraff & Witkin 1998),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Chapter 06 changes only the solve: our own PCG, warm-started, allocation-free.
@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <iostream>
 #include <limits>
 #include <stdexcept>
 
@@ -88,7 +87,8 @@ void CustomPcgStepper::build_block_offsets() {
     }
   }
   if (!block_offsets_match_pattern())
-    throw std::logic_error("03_indexed_access: the block offset table does not match the pattern");
+    throw std::logic_error(
+        "06_custom_pcg: the block offset table does not match the pattern");
 }
 
 bool CustomPcgStepper::block_offsets_match_pattern() const {
@@ -146,8 +146,8 @@ void CustomPcgStepper::compose_system(const State& state) {
   for (int k = 0; k < model_.dofs; ++k)
     A[diagonal_offsets_[k]] += mass_factor * model_.lumped_mass[k];
   // b = h (f - alpha M v) + h df/dx ((h + beta) v), one product with a dense vector.
-  tmp_ = (h + beta) * state.v;
-  b_.noalias() = h * (dfdx_ * tmp_);
+  scaled_v_ = (h + beta) * state.v;
+  b_.noalias() = h * (dfdx_ * scaled_v_);
   b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
   b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary
 }
@@ -281,10 +281,12 @@ PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd&
     return result;
   }
   // Every product writes into q with noalias(): without it Eigen would evaluate the product
-  // into a temporary first, in case q appeared on the right. And A is symmetric, so A p =
-  // A^T p: the transpose of a column-major matrix is a row-major view, whose product is a
-  // dot product per row (a gather, each q_i written once) instead of chapter 05's scatter
-  // of each column into q (the README measures the difference).
+  // into a temporary first, in case q appeared on the right. A is symmetric, so A p = A^T p,
+  // and the transposed view is a row-major product: a gather, each q_i written once. That is
+  // what ConjugateGradient<M, Lower|Upper> does too (TransposeInput in ConjugateGradient.h).
+  // On one core it buys no speed: both of Eigen's kernels are scalar loops
+  // (sparse_time_dense_product_impl in SparseDenseProduct.h), and fem_lessons spmv measures
+  // them within a few percent of each other. Its gain is that rows can be split over threads.
   filter(constraints, y);
   q.noalias() = A.transpose() * y;
   r = b - q;

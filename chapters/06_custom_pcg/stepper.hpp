@@ -21,7 +21,9 @@ struct PcgWorkspace {
 
 struct PcgResult {
   int iterations = 0;
-  double relative_residual = 0.0;  // ||b - A y|| / ||b||, as Eigen's error()
+  // ||r|| / ||b|| with r the recurrence residual (r -= step q), filtered, as Eigen's error():
+  // it equals ||S (b - A y)|| / ||b|| only up to the rounding the recurrence accumulates.
+  double relative_residual = 0.0;
   bool converged = false;
 };
 
@@ -79,13 +81,13 @@ class CustomPcgStepper final : public Stepper {
   std::vector<BlockOffsets> block_offsets_;  // per element, built once with the pattern
   Eigen::SparseMatrix<double> A_;            // M - h df/dv - h^2 df/dx, the pattern of dfdx_
   std::vector<int> diagonal_offsets_;        // where entry (k, k) sits in the value arrays
-  Eigen::VectorXd b_;                        // h (f + h df/dx v)
+  Eigen::VectorXd b_;                        // h (f + f_ext + df/dv v + h df/dx v)
   Eigen::VectorXd z_;                        // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;               // S (b - A z)
   Eigen::VectorXd dv_;
 
   // Reused across steps: sized on the first step, never reallocated afterwards.
-  Eigen::VectorXd tmp_;  // (h + beta) v
+  Eigen::VectorXd scaled_v_;  // (h + beta) v, the vector df/dx multiplies in b
 
   // The block structure of the pattern, built once. Column block j (the columns of node j)
   // holds one 3x3 block per neighbour i, in order; block k starts at row 3 * (its k-th

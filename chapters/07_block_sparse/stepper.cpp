@@ -1,5 +1,5 @@
 // Chapter 07: one linearized backward Euler step (Baraff & Witkin 1998),
-//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + h df/dx v),
+//   A dv = b,  A = M - h df/dv - h^2 df/dx,  b = h (f + f_ext + df/dv v + h df/dx v),
 // with velocity constraints by the filter S of the PPCG method (Tamstorf et al. 2015):
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // Chapter 07 changes the storage: 3x3 blocks in block compressed rows, instead of scalars
@@ -152,9 +152,9 @@ void BlockSparseStepper::compose_system(const State& state) {
   for (int i = 0; i < model_.num_nodes; ++i)
     A_.blocks[diagonal_block_[i]].diagonal() += mass_factor * model_.lumped_mass.segment<3>(3 * i);
   // b = h (f - alpha M v) + h df/dx ((h + beta) v), one block product with a dense vector.
-  tmp_ = (h + beta) * state.v;
+  scaled_v_ = (h + beta) * state.v;
   b_.resize(model_.dofs);
-  dfdx_.multiply(tmp_, b_);
+  dfdx_.multiply(scaled_v_, b_);
   b_ *= h;
   b_ += h * f_ - (h * alpha) * model_.lumped_mass.cwiseProduct(state.v);
   b_ += h * f_ext_;  // a sparse vector added into a dense one: no temporary

@@ -47,7 +47,9 @@ struct PcgWorkspace {
 
 struct PcgResult {
   int iterations = 0;
-  double relative_residual = 0.0;  // ||b - A y|| / ||b||, as Eigen's error()
+  // ||r|| / ||b|| with r the recurrence residual (r -= step q), filtered, as Eigen's error():
+  // it equals ||S (b - A y)|| / ||b|| only up to the rounding the recurrence accumulates.
+  double relative_residual = 0.0;
   bool converged = false;
 };
 
@@ -88,11 +90,11 @@ class BlockSparseStepper final : public Stepper {
   BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the pattern of dfdx_
   std::vector<int> diagonal_block_;   // per node: index of block (i, i)
   std::vector<int> transpose_block_;  // per block (i, j): index of block (j, i)
-  Eigen::VectorXd b_;                 // h (f + h df/dx v)
+  Eigen::VectorXd b_;                 // h (f + f_ext + df/dv v + h df/dx v)
   Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;        // S (b - A z)
   Eigen::VectorXd dv_;
-  Eigen::VectorXd tmp_;  // (h + beta) v
+  Eigen::VectorXd scaled_v_;  // (h + beta) v, the vector df/dx multiplies in b
   PcgWorkspace pcg_;
   Eigen::VectorXd y_;  // the unknown of the filtered system, dv = y + z: also the warm start
 };

@@ -25,7 +25,7 @@ TEST_CASE("ch01: the cantilever swings down under gravity and every solve conver
 }
 
 TEST_CASE("ch01: the filtered system S A S^T + I - S is symmetric positive definite", "[ch01]") {
-  const Scene scene = test::test_scene("sliding");  // every filter case
+  const Scene scene = test::driven_scene();  // every filter case, tilted, driven
   ch01::NaiveStepper stepper(scene, {});
   State state = rest_state(scene);
   for (int k = 0; k < 5; ++k) stepper.step(state);
@@ -48,7 +48,13 @@ TEST_CASE("ch01: allocations per step are the same every step after the first", 
     const long long count = test::allocations_per_step("01", test::test_scene(name));
     INFO(name << ": " << count << " allocations per step (-1: not the same every step)");
     // The naive stepper allocates in every phase but df/dx: sparse expressions, S, the
-    // products, CG's work vectors. The count depends only on the pattern.
-    CHECK(count >= 20);
+    // products, CG's work vectors. The count depends only on the pattern and the Eigen
+    // version (measured with Eigen 3.4.0 on the test mesh), so it is asserted exactly.
+    const long long expected = std::string(name) == "cantilever" ? 106 : 105;
+    CHECK(count == expected);
   }
+}
+
+TEST_CASE("ch01: mass damping slows a rigid translation by 1/(1 + h alpha) per step", "[ch01]") {
+  test::check_damping_rate("01");
 }

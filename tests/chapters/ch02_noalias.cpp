@@ -8,10 +8,7 @@
 
 using namespace fem;
 
-TEST_CASE("ch02: matches chapter 01 on both scenes over 50 steps", "[ch02]") {
-  for (const char* name : {"cantilever", "sliding"})
-    test::check_matches_ch01("02", test::test_scene(name));
-}
+FEM_CHAPTER_TESTS("02", "[ch02]")
 
 TEST_CASE("ch02: allocates strictly fewer per step than chapter 01", "[ch02][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();

@@ -8,10 +8,7 @@
 
 using namespace fem;
 
-TEST_CASE("ch03: matches chapter 01 on both scenes over 50 steps", "[ch03]") {
-  for (const char* name : {"cantilever", "sliding"})
-    test::check_matches_ch01("03", test::test_scene(name));
-}
+FEM_CHAPTER_TESTS("03", "[ch03]")
 
 TEST_CASE("ch03: the offset table gives bit-identical df/dx to the coeffRef fill", "[ch03]") {
   const Scene scene = test::test_scene("sliding");

@@ -7,10 +7,7 @@
 
 using namespace fem;
 
-TEST_CASE("ch06: matches chapter 01 on both scenes over 50 steps", "[ch06]") {
-  for (const char* name : {"cantilever", "sliding"})
-    test::check_matches_ch01("06", test::test_scene(name));
-}
+FEM_CHAPTER_TESTS("06", "[ch06]")
 
 TEST_CASE("ch06: zero heap allocations per step after the first", "[ch06][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();

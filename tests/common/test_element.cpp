@@ -150,6 +150,21 @@ TEST_CASE("polar rotation is a proper rotation, also for an inverted element", "
   CHECK((S - S.transpose()).norm() < 1e-12 * S.norm());
 }
 
+TEST_CASE("polar rotation of an inverted element: the flip is on the smallest singular value",
+          "[element]") {
+  // F = R0 diag(s) with one negative entry. The corotational convention (Irving et al.
+  // 2004) makes det R = +1 by flipping the direction of the SMALLEST singular value, the one
+  // an element crushed through a face has lost: the rotation is then R0 when that direction
+  // is the inverted one, and R0 diag(-1, 1, -1) when the largest is. Flipping any other
+  // direction also gives det 1 and an orthogonal R, so only the known answer tests it.
+  const Eigen::Matrix3d R0 = some_rotation();
+  const Eigen::Matrix3d crushed = R0 * Eigen::Vector3d(2.0, 1.5, -0.5).asDiagonal();
+  CHECK((polar_rotation(crushed) - R0).norm() < 1e-12);
+  const Eigen::Matrix3d flipped_long_axis = R0 * Eigen::Vector3d(-2.0, 1.5, 0.5).asDiagonal();
+  const Eigen::Matrix3d expected = R0 * Eigen::Vector3d(-1.0, 1.0, -1.0).asDiagonal();
+  CHECK((polar_rotation(flipped_long_axis) - expected).norm() < 1e-12);
+}
+
 TEST_CASE("an inverted element gets a finite force that pushes it back", "[element]") {
   const ElementRest rest = make_element_rest(rest_positions(), kLame);
   // Push node 3 through the face (0, 1, 2), to half its height on the other side. (Not

@@ -43,7 +43,7 @@ TEST_CASE("forces set after construction act like the scene's own, in every chap
   }
 }
 
-TEST_CASE("forces on the same node add up; clearing them removes them", "[external]") {
+TEST_CASE("forces on the same node add up, and clearing them removes them", "[external]") {
   const Scene scene = test::test_scene("cantilever");
   auto stepper = make_stepper("01", scene);
   const auto forces = pull_on_the_tip(scene);

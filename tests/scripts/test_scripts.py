@@ -81,17 +81,35 @@ def main():
         # Tables: a copy of the docs with the markers, filled from the fixture.
         root = tmp / "repo"
         for rel in ["README.md", "docs/results.md", "chapters/01_naive/README.md",
-                    "chapters/06_custom_pcg/README.md", "chapters/09_threads/README.md"]:
+                    "chapters/02_noalias/README.md", "chapters/06_custom_pcg/README.md",
+                    "chapters/09_threads/README.md"]:
             (root / rel).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy(ROOT / rel, root / rel)
-        (root / "results").mkdir()
-        shutil.copy(FIXTURE, root / "results" / "bench.json")
-        shutil.copy(scaling, root / "results" / "scaling.json")
-        shutil.copy(FIXTURE, root / "results" / "threads.json")
+        data = root / "docs" / "data"  # where the JSON behind the committed docs lives
+        data.mkdir(parents=True)
+        shutil.copy(FIXTURE, data / "bench.json")
+        shutil.copy(scaling, data / "scaling.json")
+        shutil.copy(FIXTURE, data / "threads.json")
         viewer = viewer_fixture(bench)
-        (root / "results" / "viewer.json").write_text(json.dumps(viewer))
+        (data / "viewer.json").write_text(json.dumps(viewer))
+        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
+        check("update_docs.py --check fails on docs made from other data", p.returncode == 1,
+              p.stdout + p.stderr)
         p = run(SCRIPTS / "update_docs.py", "--root", root)
         check("update_docs.py exits 0", p.returncode == 0, p.stderr)
+        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
+        check("update_docs.py --check passes right after update_docs.py", p.returncode == 0,
+              p.stdout + p.stderr)
+        chapter02 = (root / "chapters" / "02_noalias" / "README.md").read_text()
+        check("chapter 02's table has one speedup row (over 01, its previous chapter)",
+              chapter02.count("| speedup over `01_naive` |") == 1)
+        tampered = (root / "docs" / "results.md").read_text().replace(
+            update_docs.ms(bench["chapters"][0]["median_ms"]["step"]), "1234.5", 1)
+        (root / "docs" / "results.md").write_text(tampered)
+        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
+        check("update_docs.py --check fails on a hand-edited number", p.returncode == 1 and
+              "docs/results.md" in p.stderr, p.stdout + p.stderr)
+        run(SCRIPTS / "update_docs.py", "--root", root)
         results_md = (root / "docs" / "results.md").read_text()
         naive = next(c for c in bench["chapters"] if c["chapter"] == "01_naive")
         last = bench["chapters"][-1]
@@ -139,6 +157,23 @@ def main():
         bad.write_text(json.dumps(broken))
         p = run(SCRIPTS / "validate_bench.py", bad)
         check("validate_bench.py exits 1 on a broken file", p.returncode == 1, p.stdout + p.stderr)
+
+        # The chapter drift check: a chapter copied forward and not renamed is caught.
+        drift = tmp / "drift"
+        (drift / "chapters" / "08_copied").mkdir(parents=True)
+        (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
+            '// Chapter 07: one linearized backward Euler step\n#include <iostream>\n'
+            'void f() { throw 1 ? "07_block_sparse: a table does not match" : ""; }\n')
+        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
+        check("check_chapter_sources.py catches a header, a string and an unused <iostream>",
+              p.returncode == 1 and "'Chapter 07'" in p.stderr and "names chapter 07" in p.stderr
+              and "<iostream>" in p.stderr, p.stderr)
+        (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
+            '// Chapter 08: one step, as chapter 07 wrote it\n#include "chapters/07_x/stepper.hpp"\n'
+            'void f() { throw "08_copied: a table does not match"; }\n')
+        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
+        check("check_chapter_sources.py accepts a chapter that names only itself",
+              p.returncode == 0, p.stdout + p.stderr)
 
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0

@@ -125,7 +125,7 @@ TEST_CASE("switching chapters keeps the state and continues the same motion", "[
   CHECK(session.history().size() == 10);  // the panel's history restarts with the chapter
 }
 
-TEST_CASE("new material keeps the state; a new scene starts from rest", "[viewer]") {
+TEST_CASE("new material keeps the state, and a new scene starts from rest", "[viewer]") {
   Session session(test::test_mesh(), test_settings(), "05");
   for (int k = 0; k < 5; ++k) session.step();
   const State moved = session.state();

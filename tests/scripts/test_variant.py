@@ -1,0 +1,125 @@
+#!/usr/bin/env python3
+"""Tests of ./tutorial.sh variant (scripts/make_variant.py) on a copy of the chapters: the copy
+is made with its namespace and includes renamed and a variant_of file; the build's registry
+generator (chapters/registry.cmake) lists it after its original with its title; it compiles
+beside the original (the generated registry includes both headers); the generated-diff check
+leaves it out; bad requests are refused with the reason. Prints 'N passed, M failed' last.
+
+    test_variant.py --cxx g++ --include /usr/include/eigen3"""
+import argparse
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+results = {"passed": 0, "failed": 0}
+
+
+def check(name, condition, detail=""):
+    results["passed" if condition else "failed"] += 1
+    print(f"{'ok  ' if condition else 'FAIL'} {name}{'' if condition else ': ' + str(detail)[:3000]}")
+
+
+def run(*args, cwd=None):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd)
+
+
+def copy_repo(tmp):
+    """The parts of the repository the variant, the registry and the diffs need, without the
+    student's own variants of the working tree."""
+    def ignore(directory, names):
+        return {n for n in names if n == "__pycache__" or (pathlib.Path(directory) / n / "variant_of").exists()}
+    repo = tmp / "repo"
+    for part in ("chapters", "common", "scripts", "docs/diffs"):
+        shutil.copytree(ROOT / part, repo / part, ignore=ignore)
+    return repo
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--cxx", default="c++")
+    parser.add_argument("--include", action="append", default=[], help="include directories")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        repo = copy_repo(pathlib.Path(tmp))
+        make = [sys.executable, repo / "scripts" / "make_variant.py", "--root", repo]
+        # The copy's diffs made current first, so that the check below is about the variant
+        # alone (the repository's own diffs have their own test).
+        run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo)
+
+        p = run(*make, "06", "my_fused_updates")
+        check("make_variant.py 06 my_fused_updates exits 0", p.returncode == 0, p.stderr)
+        variant = repo / "chapters" / "06_my_fused_updates"
+        check("the copy has the original's files",
+              sorted(f.name for f in (repo / "chapters" / "06_custom_pcg").iterdir()) + ["variant_of"]
+              == sorted(f.name for f in variant.iterdir()), list(variant.iterdir()))
+        check("variant_of names the original",
+              (variant / "variant_of").read_text().strip() == "06_custom_pcg")
+        hpp, cpp = (variant / "stepper.hpp").read_text(), (variant / "stepper.cpp").read_text()
+        check("the namespace is renamed", "namespace fem::ch06_my_fused_updates {" in hpp
+              and "fem::ch06 " not in hpp and "ch06::" not in cpp, hpp[:2000])
+        check("the copy includes its own header", '#include "chapters/06_my_fused_updates/stepper.hpp"' in cpp
+              and "chapters/06_custom_pcg/" not in cpp)
+        check("the README's heading names the variant and its original",
+              (variant / "README.md").read_text().startswith(
+                  "# Chapter 06_my_fused_updates: a variant of 06_custom_pcg ("))
+
+        # Refusals, with the reason.
+        for bad, reason in ((["06", "my_fused_updates"], "exists already"),
+                            (["99", "x"], "no chapter 99"),
+                            (["06", "Bad-Name"], "not a variant name")):
+            p = run(*make, *bad)
+            check(f"make_variant.py {' '.join(bad)} is refused ({reason})",
+                  p.returncode == 2 and reason in p.stderr, p.stderr)
+
+        p = run(ROOT / "tutorial.sh", "variant", "06")
+        check("./tutorial.sh variant without a name prints its usage and exits 2",
+              p.returncode == 2 and "usage: ./tutorial.sh variant NN NAME" in p.stderr, p.stderr)
+
+        # The registry the build would generate.
+        generated = repo / "chapter_list.cpp"
+        p = run("cmake", f"-DSOURCE_DIR={repo}", f"-DOUTPUT={generated}", "-P",
+                repo / "chapters" / "registry.cmake")
+        check("registry.cmake generates the list", p.returncode == 0 and generated.exists(), p.stderr)
+        text = generated.read_text() if generated.exists() else ""
+        check("the variant is registered with its original",
+              'chapter<fem::ch06_my_fused_updates::CustomPcgStepper>("06_my_fused_updates", '
+              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg"),' in text, text)
+        check("the originals keep their entries",
+              'chapter<fem::ch06::CustomPcgStepper>("06_custom_pcg"' in text
+              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "")' in text, text)
+
+        # Original and variant compile side by side (no clash of names), the variant's own file too.
+        flags = ["-std=c++17", "-fsyntax-only", f"-I{repo}", *[f"-I{i}" for i in args.include],
+                 "-DFEM_SOURCE_DIR=\"/\""]
+        for source in (generated, variant / "stepper.cpp"):
+            p = run(args.cxx, *flags, source)
+            check(f"{source.name} of the variant compiles", p.returncode == 0, p.stderr)
+
+        # A malformed chapter stops the generator with the file and the rule.
+        broken = repo / "chapters" / "08_broken"
+        broken.mkdir()
+        (broken / "stepper.hpp").write_text("namespace fem::ch08 {\nstruct Nothing {};\n}\n")
+        (broken / "README.md").write_text("# Chapter 08: broken\n")
+        p = run("cmake", f"-DSOURCE_DIR={repo}", f"-DOUTPUT={generated}", "-P",
+                repo / "chapters" / "registry.cmake")
+        check("a chapter without a stepper class is refused with the rule",
+              p.returncode != 0 and "chapters/08_broken" in p.stderr and "public Stepper" in p.stderr,
+              p.stderr)
+        shutil.rmtree(broken)
+
+        # The generated-diff check ignores the variant (and still checks the course's chapters).
+        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--check", "--root", repo)
+        check("chapter_diffs.py --check leaves the variant out", p.returncode == 0, p.stderr)
+        (repo / "chapters" / "07_block_sparse" / "stepper.cpp").write_text("// changed\n")
+        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--check", "--root", repo)
+        check("chapter_diffs.py --check still catches a changed chapter", p.returncode == 1, p.stdout)
+
+    print(f"{results['passed']} passed, {results['failed']} failed")
+    return 1 if results["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
