@@ -488,7 +488,10 @@ void print_table(const std::vector<ChapterResult>& results) {
       std::cout << std::left << std::setw(26) << r.chapter << std::right << std::fixed
                 << std::setprecision(2);
       for (std::size_t i = 0; i < r.ms.size(); ++i)
-        std::cout << std::setw(11) << results.front().ms[i].median / r.ms[i].median << "x";
+        if (r.ms[i].median > 0.0)
+          std::cout << std::setw(11) << results.front().ms[i].median / r.ms[i].median << "x";
+        else  // a phase the chapter does not have (a fused pass: no df/dx built)
+          std::cout << std::setw(12) << "-";
       std::cout << std::defaultfloat << "\n";
     }
   }
