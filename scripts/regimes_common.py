@@ -117,7 +117,10 @@ def value(point, key, name):
 
 def best_chapter(point, key):
     """The chapter with the highest ratio for a phase at this point (not chapter 01)."""
-    others = [c["chapter"] for c in point["chapters"] if c["chapter"] != BASELINE]
+    # A chapter without the phase (0 ms: chapter 08's df/dx, fused into its element pass) has
+    # no ratio for it, not an infinite one.
+    others = [c["chapter"] for c in point["chapters"]
+              if c["chapter"] != BASELINE and c["median_ms"].get(key, 1.0) > 0]
     return max(others, key=lambda n: speedup(point, n, key)) if others else BASELINE
 
 

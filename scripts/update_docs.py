@@ -190,6 +190,13 @@ def chapter_table(data, name):
     c = by[name]
     names = [x["chapter"] for x in data["chapters"]]
     previous = by.get(names[names.index(name) - 1]) if names.index(name) > 0 else None
+    # A threaded row compares with the chapter before at the same thread count (10@2 with
+    # 09@2); without one (09@2: chapter 08 has one thread only) with the row before (09@1).
+    same_threads = [x for x in data["chapters"][:names.index(name)]
+                    if chapter_dir(x["chapter"]) != chapter_dir(name)
+                    and x.get("threads", 1) == c.get("threads", 1)]
+    if "@" in name and same_threads:
+        previous = same_threads[-1]
     shown = [x for x in (by.get(BASELINE), previous, c) if x is not None]
     shown = [x for i, x in enumerate(shown) if x not in shown[:i]]
     rows = [[f"`{x['chapter']}`"] + [ms(x["median_ms"][p]) for p in ALL_PHASES] +
