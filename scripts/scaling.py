@@ -74,8 +74,8 @@ def main():
                                  "allocations_per_step": c["allocations_per_step"]})
                     print(f"  {name:10s} {c['chapter']:24s} {data['mesh']['nodes']:7d} nodes  step "
                           f"{c['median_ms']['step']:10.2f} ms  ({time.time() - start:5.1f} s)", flush=True)
-                if chapter == "all":  # the first size names the chapters
-                    active = [c["chapter"] for c in data["chapters"]]
+                if chapter == "all":  # the first size names the chapters (09_threads@1 and @2: one run)
+                    active = list(dict.fromkeys(c["chapter"].split("@")[0] for c in data["chapters"]))
             if active is None:
                 active = list(todo)
     if header is None:

@@ -123,7 +123,13 @@ def scaling_table(scaling):
     step = {(r["chapter"], r["nodes"]): r["step_ms"] for r in scaling["runs"]}
     rows = [[f"`{c}`"] + [ms(step[(c, n)]) if (c, n) in step else "stopped" for n in sizes]
             for c in chapters]
-    return table(["median step ms / nodes"] + [str(n) for n in sizes], rows)
+    # The iterations say why the step grows faster than the mesh: Jacobi's count grows with
+    # the resolution, multigrid's (chapter 10) should not.
+    its = {(r["chapter"], r["nodes"]): r["cg_iterations"] for r in scaling["runs"]}
+    it_rows = [[f"`{c}`"] + [f"{its[(c, n)]:g}" if (c, n) in its else "stopped" for n in sizes]
+               for c in chapters]
+    return (table(["median step ms / nodes"] + [str(n) for n in sizes], rows) + "\n" +
+            table(["median CG iterations / nodes"] + [str(n) for n in sizes], it_rows))
 
 
 def viewer_table(viewer):
