@@ -41,7 +41,7 @@ commands:
              meshes generated on demand), with a time budget per run: results/scaling.json and
              results/scaling.png
   regimes    build and run every chapter on both poster-sized bodies (the thin plate, the perforated
-             bar) over a sweep of Young's modulus, with the solve table at each point (about 10
+             bar) over a sweep of Young's modulus, with the solve table at each point (a few
              minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
              scripts/regimes.py (--help)
   threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
