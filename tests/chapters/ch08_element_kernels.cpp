@@ -13,21 +13,6 @@ using namespace fem;
 
 namespace {
 
-// The sliding scene with its fixed corner driven sideways: every filter case (free, plane,
-// line, fixed) on non-axis-aligned planes and lines, and a prescribed velocity change.
-Scene driven_scene() {
-  Scene scene = test::test_scene("sliding");
-  const Eigen::Vector3d tilted = Eigen::Vector3d(0.2, 0.1, 1.0).normalized();
-  for (auto& c : scene.constraints) {
-    if (c.kind == NodeConstraint::Kind::Fixed) c.target_velocity = Eigen::Vector3d(0.0, 0.05, 0.01);
-    if (c.kind == NodeConstraint::Kind::Plane) c = NodeConstraint::plane(c.node, tilted);
-    if (c.kind == NodeConstraint::Kind::Line)
-      c = NodeConstraint::line(c.node, Eigen::Vector3d(1.0, 0.1, -0.05).normalized());
-  }
-  scene.name = "driven";
-  return scene;
-}
-
 // Deformation gradients F = U diag(s) V^T with random rotations U, V and given singular
 // values: the SVD rotation is then known to be U diag(1, 1, sign) V^T.
 Eigen::Matrix3d random_rotation(std::mt19937& rng) {
@@ -54,11 +39,7 @@ constexpr double kRotationTolerance = 1e-12;
 
 }  // namespace
 
-TEST_CASE("ch08: matches chapter 01 on both scenes and a driven scene over 50 steps", "[ch08]") {
-  for (const Scene& scene :
-       {test::test_scene("cantilever"), test::test_scene("sliding"), driven_scene()})
-    test::check_matches_ch01("08", scene);
-}
+FEM_CHAPTER_TESTS("08", "[ch08]")
 
 TEST_CASE("ch08: warm-started Newton gives the SVD rotation on large rotations and stretches",
           "[ch08]") {
@@ -153,7 +134,7 @@ TEST_CASE("ch08: the closed-form blocks equal common's dfdx_block for every elem
 }
 
 TEST_CASE("ch08: the fused pass builds chapter 07's filtered system", "[ch08]") {
-  for (const Scene& scene : {test::test_scene("cantilever"), driven_scene()}) {
+  for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()}) {
     ch07::BlockSparseStepper separate(scene, test::tight_solver());
     ch08::ElementKernelsStepper fused(scene, test::tight_solver());
     State state = rest_state(scene);
@@ -225,7 +206,7 @@ TEST_CASE("ch08: a stepper created on a turned body starts cold and then warm", 
 
 TEST_CASE("ch08: no element of the test scenes needs the SVD fallback", "[ch08]") {
   for (const Scene& scene :
-       {test::test_scene("cantilever"), test::test_scene("sliding"), driven_scene()}) {
+       {test::test_scene("cantilever"), test::test_scene("sliding"), test::driven_scene()}) {
     ch08::ElementKernelsStepper stepper(scene, {});
     State state = rest_state(scene);
     for (int k = 0; k < 50; ++k) stepper.step(state);
@@ -253,7 +234,7 @@ TEST_CASE("ch08: an overflowing system stops the solve at once and says so", "[c
 TEST_CASE("ch08: zero heap allocations per step after the first", "[ch08][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();
   for (const Scene& scene :
-       {test::test_scene("cantilever"), test::test_scene("sliding"), driven_scene()}) {
+       {test::test_scene("cantilever"), test::test_scene("sliding"), test::driven_scene()}) {
     const long long count = test::allocations_per_step("08", scene);
     INFO(scene.name);
     CHECK(count == 0);

@@ -14,16 +14,6 @@ using namespace fem;
 
 namespace {
 
-// The sliding scene with its fixed corner driven sideways: every filter case (free, plane,
-// line, fixed) and a prescribed velocity change.
-Scene driven_scene() {
-  Scene scene = test::test_scene("sliding");
-  for (auto& c : scene.constraints)
-    if (c.kind == NodeConstraint::Kind::Fixed) c.target_velocity = Eigen::Vector3d(0.0, 0.05, 0.01);
-  scene.name = "driven";
-  return scene;
-}
-
 // 1, 2 and 3 threads with OpenMP (3: a count that divides nothing evenly); 1 without.
 std::vector<int> thread_counts() {
   return openmp_enabled() ? std::vector<int>{1, 2, 3} : std::vector<int>{1};
@@ -45,7 +35,7 @@ bool bit_identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 
 TEST_CASE("ch09: bit-identical states after 50 steps with 1, 2 and 3 threads", "[ch09]") {
   for (const auto how : {ch09::ElementParallelism::colouring, ch09::ElementParallelism::gather})
-    for (const Scene& scene : {test::test_scene("cantilever"), driven_scene()}) {
+    for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()}) {
       const State reference = run_with(scene, 1, 50, how);
       REQUIRE((reference.x - rest_state(scene).x).cwiseAbs().maxCoeff() > 1e-3);  // it moves
       for (const int threads : thread_counts()) {
@@ -58,15 +48,12 @@ TEST_CASE("ch09: bit-identical states after 50 steps with 1, 2 and 3 threads", "
     }
 }
 
-TEST_CASE("ch09: matches chapter 01 on both scenes and a driven scene over 50 steps", "[ch09]") {
-  const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
-  for (const Scene& scene :
-       {test::test_scene("cantilever"), test::test_scene("sliding"), driven_scene()})
-    test::check_matches_ch01("09", scene);
-}
+// The generic chapter tests run at the process's thread count: .ci/run runs this binary
+// under OMP_NUM_THREADS=1 and 2, and the states are bit-identical across counts (below).
+FEM_CHAPTER_TESTS("09", "[ch09]")
 
 TEST_CASE("ch09: the system equals chapter 08's, by either element pass", "[ch09]") {
-  const Scene scene = driven_scene();
+  const Scene scene = test::driven_scene();
   const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
   ch08::ElementKernelsStepper serial(scene, test::tight_solver());
   ch09::ThreadsStepper colouring(scene, test::tight_solver(), ch09::ElementParallelism::colouring);
@@ -91,7 +78,7 @@ TEST_CASE("ch09: the system equals chapter 08's, by either element pass", "[ch09
 
 TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thread count",
           "[ch09]") {
-  const Scene scene = driven_scene();
+  const Scene scene = test::driven_scene();
   ch09::ThreadsStepper stepper(scene, {});
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
@@ -121,7 +108,7 @@ TEST_CASE("ch09: zero heap allocations per step after the first, with 2 threads"
   // regions of the same size, so the steps after it allocate nothing.
   const int threads = openmp_enabled() ? 2 : 1;
   const ThreadCountScope scope(threads);
-  for (const Scene& scene : {test::test_scene("cantilever"), driven_scene()}) {
+  for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()}) {
     INFO(scene.name << ", " << threads << " threads");
     CHECK(test::allocations_per_step("09", scene) == 0);
   }
@@ -133,7 +120,7 @@ TEST_CASE("ch09: one thread opens no parallel region, so it allocates nothing ei
   // libgomp frees a team of one thread at the end of each region (gomp_team_end): a region
   // per phase would cost a malloc each. run_parallel calls the body directly instead.
   const ThreadCountScope scope(1);
-  CHECK(test::allocations_per_step("09", driven_scene()) == 0);
+  CHECK(test::allocations_per_step("09", test::driven_scene()) == 0);
 }
 
 TEST_CASE("ch09: --threads style errors: a count below 1 is refused", "[ch09]") {
