@@ -163,6 +163,19 @@ def headline(data):
             f"{b['compiler']} `{b['flags']}`, commit {data['commit']}.\n")
 
 
+def reference_row(data, name):
+    """The row a chapter's row is compared with: the row before it, except that a threaded row
+    compares with the chapter before at the same thread count (10@2 with 09@2); without one
+    (09@2: chapter 08 runs on one thread) with the row before (09@1)."""
+    rows = data["chapters"]
+    i = next(k for k, x in enumerate(rows) if x["chapter"] == name)
+    same_threads = [x for x in rows[:i] if chapter_dir(x["chapter"]) != chapter_dir(name)
+                    and x.get("threads", 1) == rows[i].get("threads", 1)]
+    if "@" in name and same_threads:
+        return same_threads[-1]
+    return rows[i - 1] if i > 0 else None
+
+
 def chapter_map(data):
     """One line per chapter: the idea, the phase it moves most, the overall step speedup."""
     by = chapters_by_name(data)
@@ -171,17 +184,18 @@ def chapter_map(data):
     for c in data["chapters"]:
         name = c["chapter"]
         moved = "the baseline"
-        if previous is not None and c["median_ms"]["dfdx"] == 0 < previous["median_ms"]["dfdx"]:
+        ref = reference_row(data, name)
+        if ref is not None and c["median_ms"]["dfdx"] == 0 < ref["median_ms"]["dfdx"]:
             # A fused element pass (chapter 08) has no df/dx phase of its own: compare the three
             # phases it replaces together, not a zero.
             fused = ("forces", "dfdx", "compose")
             moved = (f"forces + df/dx + composition (fused) "
-                     f"{ratio(sum(previous['median_ms'][p] for p in fused), sum(c['median_ms'][p] for p in fused))} "
-                     f"over `{previous['chapter']}`")
-        elif previous is not None:
-            phase = max(PHASES[:-1], key=lambda p: previous["median_ms"][p] / max(c["median_ms"][p], 1e-9))
-            moved = (f"{PHASE_LABELS[phase]} {ratio(previous['median_ms'][phase], c['median_ms'][phase])} "
-                     f"over `{previous['chapter']}`")
+                     f"{ratio(sum(ref['median_ms'][p] for p in fused), sum(c['median_ms'][p] for p in fused))} "
+                     f"over `{ref['chapter']}`")
+        elif ref is not None:
+            phase = max(PHASES[:-1], key=lambda p: ref["median_ms"][p] / max(c["median_ms"][p], 1e-9))
+            moved = (f"{PHASE_LABELS[phase]} {ratio(ref['median_ms'][phase], c['median_ms'][phase])} "
+                     f"over `{ref['chapter']}`")
         diff = f"[diff](docs/diffs/{chapter_dir(name)}.diff)" if previous is not None and \
             chapter_dir(previous["chapter"]) != chapter_dir(name) else ""
         rows.append([f"[`{name}`](chapters/{chapter_dir(name)}/README.md)", c.get("title", ""), moved,
@@ -194,15 +208,7 @@ def chapter_map(data):
 def chapter_table(data, name):
     by = chapters_by_name(data)
     c = by[name]
-    names = [x["chapter"] for x in data["chapters"]]
-    previous = by.get(names[names.index(name) - 1]) if names.index(name) > 0 else None
-    # A threaded row compares with the chapter before at the same thread count (10@2 with
-    # 09@2); without one (09@2: chapter 08 has one thread only) with the row before (09@1).
-    same_threads = [x for x in data["chapters"][:names.index(name)]
-                    if chapter_dir(x["chapter"]) != chapter_dir(name)
-                    and x.get("threads", 1) == c.get("threads", 1)]
-    if "@" in name and same_threads:
-        previous = same_threads[-1]
+    previous = reference_row(data, name)
     shown = [x for x in (by.get(BASELINE), previous, c) if x is not None]
     shown = [x for i, x in enumerate(shown) if x not in shown[:i]]
     rows = [[f"`{x['chapter']}`"] + [ms(x["median_ms"][p]) for p in ALL_PHASES] +
