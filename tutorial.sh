@@ -34,6 +34,8 @@ commands:
              per-phase table; a run is a folder, --out DIR (default results) gets bench.json
              and the plots made from it; other arguments go to fem_bench (--chapters 06,07,
              --mesh, --scene, --steps; fem_bench --help)
+  diff       a variant's change against its original, the copy's renames undone (the hand-in):
+             ./tutorial.sh diff 06_my_fused_updates
   plots      remake the plots of a run folder from its bench.json: ./tutorial.sh plots DIR
   variant    copy a chapter under a new name to change it and measure it against the
              original: ./tutorial.sh variant 06 my_fused_updates (chapters/README.md)
@@ -182,6 +184,11 @@ variant() {
   "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
+diff_variant() {
+  [ $# -eq 1 ] || { echo "usage: ./tutorial.sh diff VARIANT (e.g. 06_my_fused_updates)" >&2; exit 2; }
+  python3 scripts/chapter_diffs.py --variant "$1"
+}
+
 threads() {
   quiet_build
   mkdir -p results
@@ -216,9 +223,9 @@ docs() {
   "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
   "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
-  log "multigrid tables (fem_multigrid, scripts/pyamg_reference.py: about half a minute)"
-  "$BUILD_DIR/fem_multigrid" --steps 100 --threads 1 --readme chapters/10_multigrid/README.md >/dev/null
-  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_multigrid" \
+  log "multigrid tables (fem_lessons multigrid, scripts/pyamg_reference.py: about half a minute)"
+  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --readme chapters/10_multigrid/README.md >/dev/null
+  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --readme chapters/10_multigrid/README.md >/dev/null
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
@@ -282,6 +289,7 @@ main() {
     bench) bench "$@" ;;
     plots) plots "$@" ;;
     variant) variant "$@" ;;
+    diff) diff_variant "$@" ;;
     scaling) scaling "$@" ;;
     regimes) regimes "$@" ;;
     threads) threads "$@" ;;

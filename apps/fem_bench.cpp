@@ -289,7 +289,8 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
       rows.push_back({(eigen ? "eigen_cg_rowmajor@" : "pcg_ch09@") + std::to_string(t), t, eigen, {}, {}, {}});
   ch09::ThreadsStepper stepper(scene, settings);
   State state = rest_state(scene);
-  ch09::ParallelPcg pcg(stepper.system_matrix(), stepper.diagonal_blocks(), scene.constraints);
+  ch09::ParallelPcg pcg(stepper.system_matrix(), scene.constraints);
+  ch09::BlockJacobi block_jacobi(stepper.diagonal_blocks());
   Eigen::ConjugateGradient<RowMajorMatrix, Eigen::Lower | Eigen::Upper> cg;
   cg.setTolerance(settings.tolerance);
   cg.setMaxIterations(settings.max_iterations);
@@ -310,7 +311,7 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
         iterations = static_cast<int>(cg.iterations());
       } else {
         x = previous;
-        iterations = pcg.solve(stepper.system_matrix(), b, settings, x).iterations;
+        iterations = pcg.solve(stepper.system_matrix(), block_jacobi, b, settings, x).iterations;
       }
       const double ms =
           1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

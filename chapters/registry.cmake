@@ -2,7 +2,8 @@
 # a chapter, found by the build, so adding a chapter (or a variant, ./tutorial.sh variant)
 # edits no list. The convention it reads (chapters/README.md):
 #   stepper.hpp  declares the stepper inside `namespace fem::<ns> {` as
-#                `class <Name> final : public Stepper`, constructible from (Scene, SolverSettings);
+#                `class <Name> final : public Stepper` (or `public chNN::<Name>Stepper`, a chapter's
+#                stepper it extends), constructible from (Scene, SolverSettings);
 #   README.md    starts with `# Chapter NN: <title>`, the title the apps and the results show;
 #   variant_of   (variants only) one line, the id of the chapter it was copied from.
 #
@@ -14,6 +15,9 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
   foreach(header ${FEM_CHAPTER_HEADERS})
     get_filename_component(dir ${header} DIRECTORY)
     list(APPEND FEM_CHAPTER_INPUTS ${dir}/README.md)
+    if(EXISTS ${dir}/lesson.hpp)
+      list(APPEND FEM_CHAPTER_INPUTS ${dir}/lesson.hpp)
+    endif()
     if(EXISTS ${dir}/variant_of)
       list(APPEND FEM_CHAPTER_INPUTS ${dir}/variant_of)
     endif()
@@ -64,7 +68,7 @@ foreach(header ${headers})
     fem_fail(${dir} "stepper.hpp has no `namespace fem::<name> {`")
   endif()
   set(ns ${CMAKE_MATCH_1})
-  string(REGEX MATCHALL "class[ \t\r\n]+[A-Za-z_][A-Za-z0-9_]*[ \t\r\n]+(final[ \t\r\n]+)?:[ \t\r\n]*public[ \t\r\n]+(fem::)?Stepper[^A-Za-z0-9_]"
+  string(REGEX MATCHALL "class[ \t\r\n]+[A-Za-z_][A-Za-z0-9_]*[ \t\r\n]+(final[ \t\r\n]+)?:[ \t\r\n]*public[ \t\r\n]+(fem::)?([A-Za-z_][A-Za-z0-9_]*::)?[A-Za-z0-9_]*Stepper[^A-Za-z0-9_]"
          steppers "${text}")
   list(LENGTH steppers count)
   if(NOT count EQUAL 1)
@@ -86,7 +90,13 @@ foreach(header ${headers})
   endif()
   fem_cpp_string(title_literal "${title}")
   string(APPEND includes "#include \"chapters/${header}\"\n")
-  string(APPEND entries "      chapter<fem::${ns}::${class}>(\"${dir}\", ${title_literal}, \"${variant_of}\"),\n")
+  # A chapter's lesson measurements (lesson.hpp: `std::vector<Lesson> lessons();` in its namespace).
+  set(lessons "nullptr")
+  if(EXISTS ${SOURCE_DIR}/chapters/${dir}/lesson.hpp)
+    string(APPEND includes "#include \"chapters/${dir}/lesson.hpp\"\n")
+    set(lessons "&fem::${ns}::lessons")
+  endif()
+  string(APPEND entries "      chapter<fem::${ns}::${class}>(\"${dir}\", ${title_literal}, \"${variant_of}\", ${lessons}),\n")
 endforeach()
 if(entries STREQUAL "")
   message(FATAL_ERROR "no chapters/*/stepper.hpp found")
@@ -104,12 +114,13 @@ namespace fem::detail {
 namespace {
 
 template <class ChapterStepper>
-ChapterInfo chapter(std::string id, std::string title, std::string variant_of) {
+ChapterInfo chapter(std::string id, std::string title, std::string variant_of,
+                    std::vector<Lesson> (*lessons)()) {
   return {std::move(id), std::move(title),
           [](const Scene& scene, const SolverSettings& s) {
             return std::unique_ptr<Stepper>(std::make_unique<ChapterStepper>(scene, s));
           },
-          std::move(variant_of)};
+          std::move(variant_of), lessons};
 }
 
 }  // namespace

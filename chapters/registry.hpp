@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/lesson.hpp"
 #include "common/stepper.hpp"
 
 namespace fem {
@@ -17,6 +18,8 @@ struct ChapterInfo {
   std::string title;  // one line: the idea of the chapter (its README's heading)
   std::function<std::unique_ptr<Stepper>(const Scene&, const SolverSettings&)> make;
   std::string variant_of;  // a student's variant: the chapter it was copied from; else ""
+  // The measurements behind the chapter's lesson tables (its lesson.hpp), or nullptr.
+  std::vector<Lesson> (*lessons)() = nullptr;
 };
 
 // Every chapter present, in order; each variant right after the chapter it came from.

@@ -220,4 +220,16 @@ void write_between_markers(const std::string& path, const std::string& name,
   std::ofstream(path) << doc;
 }
 
+int run_program(const std::string& program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const UsageError& e) {
+    std::cerr << program << ": " << e.what() << " (see " << program << " --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
 }  // namespace fem

@@ -2,6 +2,7 @@
 // defaults, flags, --help, and clear errors for anything else.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,11 @@ void add_thread_option(ArgParser& args);
 // Applies --threads when given; returns the thread count in use. Throws UsageError for a
 // count below 1, or above 1 in a build without OpenMP.
 int threads_from_args(const ArgParser& args);
+
+// main()'s error handling, written once: returns body()'s exit status; a UsageError prints
+// "<program>: <why> (see <program> --help)" and returns 2, any other exception
+// "<program>: error: <why>" and returns 1.
+int run_program(const std::string& program, const std::function<int()>& body);
 
 // A relative mesh path is looked up from the working directory, then from the repository.
 std::string resolve_mesh_path(const std::string& path);

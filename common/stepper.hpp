@@ -18,6 +18,16 @@ struct PhaseCost {
   long long allocations = 0;
 };
 
+// What a preconditioned CG reports about one solve (chapters 06 on).
+struct SolveStats {
+  int iterations = 0;
+  // ||r|| / ||b|| with r the recurrence residual (r -= step q), filtered, which is what
+  // Eigen's ConjugateGradient::error() reports too: it equals ||S (b - A y)|| / ||b|| only up
+  // to the rounding the recurrence accumulates.
+  double relative_residual = 0.0;
+  bool converged = false;
+};
+
 // The poster's phases during the last step, plus solver facts.
 struct StepProfile {
   PhaseCost forces;       // rotations and element forces (identical in every chapter)
@@ -29,6 +39,12 @@ struct StepProfile {
   int cg_iterations = 0;
   double relative_residual = 0.0;  // ||r|| / ||rhs|| of the last solve
   bool converged = true;           // false when the solve stopped at the iteration cap
+
+  void record(const SolveStats& solve) {
+    cg_iterations = solve.iterations;
+    relative_residual = solve.relative_residual;
+    converged = solve.converged;
+  }
 };
 
 // Conjugate gradient settings, the same for every chapter so that timings compare.

@@ -1,47 +1,152 @@
 #!/usr/bin/env python3
-"""Writes docs/diffs/NN_name.diff: `diff -u` of each chapter's stepper.cpp and stepper.hpp
-against the previous chapter's, the lesson of each chapter as a diff. With --check, writes
-nothing and exits 1 if a committed diff is stale (the test that keeps them honest).
+"""Writes docs/diffs/NN_name.diff: the lesson of each chapter as a diff against the chapter
+before. Every source file of the chapter's folder (.hpp, .cpp) is diffed against the file of
+the same name in the previous chapter; a file the previous chapter does not have shows as
+added, and so does a file that includes its namesake of the previous chapter (chapter 10's
+stepper extends chapter 09's instead of copying it), as do the lesson measurements
+(lesson.hpp, lesson.cpp), which never copy forward. Before diffing, the previous chapter's
+text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
+header's path, "Chapter NN"), so that no hunk is a rename. With --check, writes nothing and
+exits 1 if a committed diff is stale or any hunk only changes names.
 
-    .venv/bin/python scripts/chapter_diffs.py            # regenerate
-    .venv/bin/python scripts/chapter_diffs.py --check    # compare with the committed ones
+    .venv/bin/python scripts/chapter_diffs.py                    # regenerate
+    .venv/bin/python scripts/chapter_diffs.py --check            # compare with the committed ones
+    .venv/bin/python scripts/chapter_diffs.py --variant 10_mine  # a variant against its original
 """
 import argparse
 import difflib
 import pathlib
+import re
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
+ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
 
 
 def chapter_dirs(root):
     """The course's chapters: a student's variant (./tutorial.sh variant, marked by its
     variant_of file) is no lesson, and its diff against the original is the student's own."""
     return sorted(d for d in (root / "chapters").iterdir()
-                  if d.is_dir() and d.name[:2].isdigit() and not (d / "variant_of").exists())
+                  if d.is_dir() and d.name[:2].isdigit() and (d / "stepper.hpp").exists()
+                  and not (d / "variant_of").exists())
+
+
+def names(chapter):
+    """What is renamed from chapter to chapter: namespace, stepper class, id, number."""
+    match = STEPPER_CLASS.search((chapter / "stepper.hpp").read_text())
+    namespace = re.search(r"namespace fem::(\w+) \{", (chapter / "stepper.hpp").read_text())
+    return {"id": chapter.name, "number": chapter.name[:2],
+            "namespace": namespace.group(1) if namespace else "",
+            "class": match.group(1) if match else ""}
+
+
+def renamed(text, old, new):
+    """text of chapter `old` with the names of chapter `new`."""
+    text = text.replace(f"chapters/{old['id']}/stepper.hpp", f"chapters/{new['id']}/stepper.hpp")
+    text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
+    if old["namespace"]:
+        text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
+    if old["class"] and new["class"]:
+        text = re.sub(rf"\b{old['class']}\b", new["class"], text)
+    return re.sub(rf"\bChapter {old['number']}\b", f"Chapter {new['number']}", text)
+
+
+def source_files(chapter):
+    return sorted(p for p in chapter.iterdir() if p.suffix in (".hpp", ".cpp"))
+
+
+def file_diff(previous, current, name, root):
+    b = current / name
+    a = previous / name
+    new_lines = b.read_text().splitlines(keepends=True)
+    # The chapter extends the previous one's file instead of copying it: its header (same
+    # stem, .hpp) includes the previous chapter's.
+    header = current / (pathlib.Path(name).stem + ".hpp")
+    extends = header.exists() and f'#include "chapters/{previous.name}/{header.name}"' in header.read_text()
+    if name in ALWAYS_ADDED or not a.exists() or extends:
+        return list(difflib.unified_diff([], new_lines, fromfile="/dev/null",
+                                         tofile=str(b.relative_to(root))))
+    old_text = renamed(a.read_text(), names(previous), names(current))
+    return list(difflib.unified_diff(old_text.splitlines(keepends=True), new_lines,
+                                     fromfile=str(a.relative_to(root)),
+                                     tofile=str(b.relative_to(root))))
 
 
 def diff(previous, current, root):
     out = []
-    for name in ("stepper.hpp", "stepper.cpp"):
-        a, b = previous / name, current / name
-        out += difflib.unified_diff(
-            a.read_text().splitlines(keepends=True), b.read_text().splitlines(keepends=True),
-            fromfile=str(a.relative_to(root)), tofile=str(b.relative_to(root)))
+    for path in source_files(current):
+        out += file_diff(previous, current, path.name, root)
+    return "".join(out)
+
+
+GENERIC = [(re.compile(r"\bch\d\d\w*"), "chNN"), (re.compile(r"\b\d\d_[a-z]\w*"), "NN_name"),
+           (re.compile(r"\b\w+Stepper\b"), "Stepper"), (re.compile(r"\bChapter \d\d\b"), "Chapter NN")]
+
+
+def rename_only_hunks(text):
+    """The hunks whose removed and added lines are the same once every chapter name is
+    replaced by a placeholder: a change of names only."""
+    def generic(line):
+        for pattern, placeholder in GENERIC:
+            line = pattern.sub(placeholder, line)
+        return line
+    found, removed, added, header = [], [], [], None
+
+    def close():
+        if header and (removed or added) and [generic(l) for l in removed] == [generic(l) for l in added]:
+            found.append(header.strip())
+    for line in text.splitlines():
+        if line.startswith("@@"):
+            close()
+            header, removed, added = line, [], []
+        elif line.startswith("-") and not line.startswith("---"):
+            removed.append(line[1:])
+        elif line.startswith("+") and not line.startswith("+++"):
+            added.append(line[1:])
+    close()
+    return found
+
+
+def variant_diff(root, variant):
+    """The variant's change: its files against the original's as make_variant.py copied them
+    (the same renames of namespace, include paths and README heading), so that a one-line
+    change is one hunk."""
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+    import make_variant
+    current = root / "chapters" / variant
+    if not (current / "variant_of").exists():
+        raise SystemExit(f"chapter_diffs.py: chapters/{variant} is not a variant (no variant_of file)")
+    original = root / "chapters" / (current / "variant_of").read_text().strip()
+    out = []
+    for path in sorted(p for p in current.iterdir() if p.is_file() and p.name != "variant_of"):
+        a = original / path.name
+        old = a.read_text() if a.exists() else ""
+        if path.name == "README.md" and old:
+            old = make_variant.readme_heading(old, original.name, variant)
+        old = make_variant.rewrite(old, original.name, variant, original.name[:2])
+        out += difflib.unified_diff(old.splitlines(keepends=True),
+                                    path.read_text().splitlines(keepends=True),
+                                    fromfile=str(a.relative_to(root)), tofile=str(path.relative_to(root)))
     return "".join(out)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true", help="only check that the diffs are current")
+    parser.add_argument("--variant", help="print a variant's change against its original instead")
     parser.add_argument("--root", type=pathlib.Path, default=ROOT)
     args = parser.parse_args()
+    if args.variant:
+        sys.stdout.write(variant_diff(args.root, args.variant))
+        return 0
     out_dir = args.root / "docs" / "diffs"
     dirs = chapter_dirs(args.root)
-    stale = []
+    stale, renames = [], []
     for previous, current in zip(dirs, dirs[1:]):
         path = out_dir / f"{current.name}.diff"
         text = diff(previous, current, args.root)
+        renames += [f"{path.name}: {h}" for h in rename_only_hunks(text)]
         if args.check:
             if not path.exists() or path.read_text() != text:
                 stale.append(path)
@@ -49,12 +154,16 @@ def main():
             out_dir.mkdir(parents=True, exist_ok=True)
             path.write_text(text)
             print(f"wrote {path.relative_to(args.root)} ({text.count(chr(10))} lines)")
+    if renames:
+        print("hunks that only change names (normalise them in renamed()):\n  " + "\n  ".join(renames),
+              file=sys.stderr)
     if stale:
         print("stale chapter diffs (run scripts/chapter_diffs.py):\n  " +
               "\n  ".join(str(p.relative_to(args.root)) for p in stale), file=sys.stderr)
+    if stale or renames:
         return 1
     if args.check:
-        print(f"{len(dirs) - 1} chapter diffs are current")
+        print(f"{len(dirs) - 1} chapter diffs are current, none with a hunk of names only")
     return 0
 
 

@@ -7,7 +7,8 @@ are covered as soon as they exist) and every .cpp/.hpp in it:
     "Chapter MM" must have MM == NN, and stepper.cpp / stepper.hpp must open with
     "// Chapter NN";
   - a string literal (error messages, warnings) must not name another chapter, neither by
-    its directory name ("MM_name") nor as "chapter MM";
+    its directory name ("MM_name") nor as "chapter MM" (except in lesson.cpp, whose tables
+    compare the chapter with earlier ones by design: there only a LATER chapter is drift);
   - <iostream> is included only where std::cout, std::cerr or std::clog is used.
 
     .venv/bin/python scripts/check_chapter_sources.py            # exit 1 on any finding
@@ -51,7 +52,7 @@ def check_file(path, nn):
         for literal in STRING.findall(line):
             for m in NAMED_IN_STRING.finditer(literal):
                 other = m.group(1) or m.group(2)
-                if other != nn:
+                if other != nn and (path.name != "lesson.cpp" or other > nn):
                     problems.append(f"{path}:{number}: a string names chapter {other} "
                                     f"in chapter {nn}: {literal}")
     if "#include <iostream>" in text and not re.search(r"std::(cout|cerr|clog)\b", text):

@@ -45,7 +45,7 @@ def readme_heading(text, original, variant):
     title = re.sub(r"^# Chapter [^:]+:\s*", "", lines[0]).strip() if lines else original
     heading = (f"# Chapter {variant}: a variant of {original} ({title})\n\n"
                f"A copy of [{original}](../{original}/README.md) made with `./tutorial.sh variant`. "
-               f"Say here what you changed and why; `diff -ru chapters/{original} chapters/{variant}` "
+               f"Say here what you changed and why; `./tutorial.sh diff {variant}` "
                f"shows the change.\n")
     return heading + "".join(lines[1:])
 
@@ -90,7 +90,7 @@ next:
   edit chapters/{variant}/stepper.cpp
   ./tutorial.sh test -R {variant}                   # the checks every chapter passes
   ./tutorial.sh bench --chapters {original[:2]},{variant} --out results/{args.name}
-  diff -ru chapters/{original} chapters/{variant}     # your change""")
+  ./tutorial.sh diff {variant}                   # your change, the copy's renames undone""")
     return 0
 
 

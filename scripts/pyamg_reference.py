@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Chapter 10's reference: PyAMG's smoothed aggregation on the same filtered systems.
 
-For each mesh, runs `fem_multigrid --export` (chapter 10 for some steps, then the last step's
+For each mesh, runs `fem_lessons multigrid --export` (chapter 10 for some steps, then the last step's
 filtered system S A S + I - S, its right-hand side and the filtered rigid-body modes as
 Matrix Market), builds pyamg.smoothed_aggregation_solver with the rigid-body modes as B and
 its defaults otherwise (symmetric strength with theta 0, standard aggregation, Jacobi-smoothed
@@ -10,7 +10,7 @@ preconditioner from a zero guess, with the stopping rule of ours: ||r|| < tol ||
 a Markdown table of the iteration counts beside chapter 10's and the block-Jacobi PCG's (chapter 09)
 on the same system, also from a zero guess.
 
-    .venv/bin/python scripts/pyamg_reference.py --tool build/release/fem_multigrid
+    .venv/bin/python scripts/pyamg_reference.py --tool build/release/fem_lessons
     .venv/bin/python scripts/pyamg_reference.py --readme chapters/10_multigrid/README.md
 (the second also writes the table between the README's pyamg-table markers)
 """
@@ -57,7 +57,7 @@ def pyamg_iterations(folder, tol, modes):
 def main():
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--tool", default=str(ROOT / "build" / "release" / "fem_multigrid"))
+    parser.add_argument("--tool", default=str(ROOT / "build" / "release" / "fem_lessons"))
     parser.add_argument("--meshes", default=",".join(DEFAULT_MESHES), help="comma-separated")
     parser.add_argument("--scene", default="cantilever")
     parser.add_argument("--steps", type=int, default=10, help="steps before the system is taken")
@@ -69,14 +69,14 @@ def main():
         parser.error("--steps must be positive and --tol in (0, 1)")
     if not pathlib.Path(args.tool).exists():
         parser.error(f"no {args.tool}: build it first (cmake --build --preset release "
-                     "--target fem_multigrid)")
+                     "--target fem_lessons)")
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.meshes.split(","):
             folder = pathlib.Path(tmp) / name
             print(f"{name}: chapter 10 for {args.steps} steps, export", file=sys.stderr, flush=True)
-            subprocess.run([args.tool, "--mesh", str(mesh_path(name)), "--scene", args.scene,
+            subprocess.run([args.tool, "multigrid", "--mesh", str(mesh_path(name)), "--scene", args.scene,
                             "--steps", str(args.steps), "--tol", str(args.tol),
                             "--modes", str(args.modes), "--threads", "1", "--export", str(folder)],
                            check=True, stdout=subprocess.DEVNULL)

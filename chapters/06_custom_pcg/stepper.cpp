@@ -223,13 +223,11 @@ void CustomPcgStepper::apply_constraints(const State& state) {
 
 void CustomPcgStepper::solve() {
   // Warm start: y_ still holds the previous step's answer; pcg_solve filters it.
-  const PcgResult result =
+  const SolveStats result =
       pcg_solve(A_, filtered_b_, scene_.constraints, diagonal_offsets_, settings_, pcg_, y_);
   dv_ = y_;
   dv_ += z_;
-  profile_.cg_iterations = result.iterations;
-  profile_.relative_residual = result.relative_residual;
-  profile_.converged = result.converged;
+  profile_.record(result);
   report_if_not_converged(profile_, settings_, "06_custom_pcg", warned_not_converged_);
 }
 
@@ -253,7 +251,7 @@ void filter(const std::vector<NodeConstraint>& constraints, Eigen::VectorXd& v) 
 
 }  // namespace
 
-PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                     const std::vector<NodeConstraint>& constraints,
                     const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
                     PcgWorkspace& work, Eigen::VectorXd& y) {
@@ -273,7 +271,7 @@ PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd&
     inverse_diagonal[k] = d != 0.0 ? 1.0 / d : 1.0;  // as Eigen's DiagonalPreconditioner
   }
 
-  PcgResult result;
+  SolveStats result;
   const double rhs_norm2 = b.squaredNorm();
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
     y.setZero();

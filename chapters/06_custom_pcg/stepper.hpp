@@ -19,21 +19,13 @@ struct PcgWorkspace {
   Eigen::VectorXd residual, preconditioned, direction, product, inverse_diagonal;
 };
 
-struct PcgResult {
-  int iterations = 0;
-  // ||r|| / ||b|| with r the recurrence residual (r -= step q), filtered, as Eigen's error():
-  // it equals ||S (b - A y)|| / ||b|| only up to the rounding the recurrence accumulates.
-  double relative_residual = 0.0;
-  bool converged = false;
-};
-
 // Jacobi-preconditioned CG on the filtered system A y = b (A = S A S^T + I - S, b = S ...),
 // with Eigen's stopping rule ||r|| <= tolerance ||b|| and an iteration cap. y holds the
 // initial guess on entry (it is filtered first) and the solution on exit. The filter S_i
 // of every constrained node is applied to the residual and the preconditioned residual
 // in each iteration, so the iterates stay in the constrained subspace (Tamstorf et al.
 // 2015). diagonal_offsets[k] is where entry (k, k) of A sits in A.valuePtr().
-PcgResult pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
+SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                     const std::vector<NodeConstraint>& constraints,
                     const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
                     PcgWorkspace& work, Eigen::VectorXd& y);

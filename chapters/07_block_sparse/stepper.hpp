@@ -6,58 +6,14 @@
 #pragma once
 
 #include <Eigen/SparseCore>
-#include <array>
 #include <vector>
 
+#include "chapters/07_block_sparse/block_pcg.hpp"
+#include "chapters/07_block_sparse/block_sparse.hpp"
 #include "common/model.hpp"
 #include "common/stepper.hpp"
 
 namespace fem::ch07 {
-
-// Block compressed-row storage: row i (node i) holds blocks row_start[i] .. row_start[i+1]-1,
-// block k is blocks[k] at block column column[k], columns sorted within a row.
-struct BlockSparseMatrix {
-  std::vector<int> row_start;
-  std::vector<int> column;
-  std::vector<Eigen::Matrix3d> blocks;
-
-  BlockSparseMatrix() = default;
-  // The pattern of a symmetric node adjacency (each row sorted, the node itself included).
-  explicit BlockSparseMatrix(const std::vector<std::vector<int>>& adjacency);
-
-  int block_rows() const { return static_cast<int>(row_start.size()) - 1; }
-  // Index of block (i, j) in blocks, found by a binary search: for set-up only.
-  int find(int i, int j) const;
-  // y = A x, one row of blocks at a time: y_i = sum_j A_ij x_j, each y_i written once.
-  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  // y = A x reading only the blocks with j >= i (A must be symmetric): y_i += A_ij x_j and
-  // y_j += A_ij^T x_i. Half the blocks read, but y is scattered.
-  void multiply_upper(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  // The same matrix with only the blocks j >= i: symmetric storage.
-  BlockSparseMatrix upper() const;
-  // Conversion for tests and comparisons (allocates).
-  Eigen::SparseMatrix<double> to_sparse() const;
-};
-
-// The work vectors of the PCG, sized on the first solve and reused afterwards.
-struct PcgWorkspace {
-  Eigen::VectorXd residual, preconditioned, direction, product;
-  std::vector<Eigen::Matrix3d> inverse_diagonal;  // block Jacobi: (A_ii)^-1
-};
-
-struct PcgResult {
-  int iterations = 0;
-  // ||r|| / ||b|| with r the recurrence residual (r -= step q), filtered, as Eigen's error():
-  // it equals ||S (b - A y)|| / ||b|| only up to the rounding the recurrence accumulates.
-  double relative_residual = 0.0;
-  bool converged = false;
-};
-
-// Block-Jacobi preconditioned CG on the filtered block system, with the same stopping rule
-// and PPCG filter as chapter 06. y holds the initial guess on entry and the solution on exit.
-PcgResult pcg_solve(const BlockSparseMatrix& A, const std::vector<int>& diagonal_block,
-                    const Eigen::VectorXd& b, const std::vector<NodeConstraint>& constraints,
-                    const SolverSettings& settings, PcgWorkspace& work, Eigen::VectorXd& y);
 
 class BlockSparseStepper final : public Stepper {
  public:
@@ -69,12 +25,11 @@ class BlockSparseStepper final : public Stepper {
   const BlockSparseMatrix& system_matrix() const { return A_; }
   const Eigen::VectorXd& system_rhs() const { return filtered_b_; }
   const BlockSparseMatrix& dfdx() const { return dfdx_; }
-  const std::vector<int>& diagonal_blocks() const { return diagonal_block_; }
+  const std::vector<int>& diagonal_blocks() const { return index_.diagonal; }
 
  private:
   void build_dfdx();
   void compose_system(const State& state);
-  void apply_constraints(const State& state);
   void solve();
 
   Scene scene_;
@@ -86,10 +41,8 @@ class BlockSparseStepper final : public Stepper {
   std::vector<Eigen::Matrix3d> rotations_;           // R_e of the polar decomposition, per element
   Eigen::VectorXd f_;                                // elastic forces + gravity
   BlockSparseMatrix dfdx_;                           // pattern of the mesh connectivity, built once
-  std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b)
-  BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the pattern of dfdx_
-  std::vector<int> diagonal_block_;   // per node: index of block (i, i)
-  std::vector<int> transpose_block_;  // per block (i, j): index of block (j, i)
+  BlockIndex index_;                                 // where element, diagonal and transposed blocks sit
+  BlockSparseMatrix A_;                              // M - h df/dv - h^2 df/dx, the pattern of dfdx_
   Eigen::VectorXd b_;                 // h (f + f_ext + df/dv v + h df/dx v)
   Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;        // S (b - A z)

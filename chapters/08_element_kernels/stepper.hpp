@@ -6,108 +6,22 @@
 // and one pass over the elements that writes forces and blocks straight into b and A.
 #pragma once
 
-#include <Eigen/Geometry>
-#include <Eigen/SparseCore>
-#include <array>
+#include <Eigen/Core>
 #include <vector>
 
+#include "chapters/07_block_sparse/block_pcg.hpp"
+#include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/08_element_kernels/element_kernels.hpp"
 #include "common/model.hpp"
 #include "common/stepper.hpp"
 
 namespace fem::ch08 {
 
-// ---- the element kernels ------------------------------------------------------------
+using ch07::BlockIndex;
+using ch07::BlockSparseMatrix;
 
-// What the fused pass reads per element: 88 bytes instead of common/'s 1.3 KB ElementRest.
-struct ElementShape {
-  Eigen::Matrix3d Dm_inv;  // F = Ds Dm^-1; its rows are the shape gradients g_1, g_2, g_3
-  double mu_volume;        // V mu
-  double lambda_volume;    // V lambda
-};
-ElementShape make_element_shape(const ElementRest& rest, const Lame& lame);
-
-// The rotation of the polar decomposition F = R S by Newton's method on the rotations,
-// started from q (the warm start: predicted from the last steps' rotations) and written
-// back to q.
-// Returns the number of iterations, or -1 where Newton cannot decide: F inverted, flat or
-// collapsed (det F too small against |F|^3), or an iterate outside the basin of the polar
-// rotation (where R^T F is not positive definite enough to give a Newton step), or no
-// convergence within the iteration cap. q is unusable after -1.
-int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q);
-
-// Newton's start: the rotation extrapolated at constant angular velocity from the last two
-// steps', R_k R_{k-1}^T R_k. Its error is the change of the angular velocity, second order
-// in the time step, where the last rotation alone is first order: one Newton iteration less.
-inline Eigen::Quaterniond predicted_rotation(const Eigen::Quaterniond& last,
-                                             const Eigen::Quaterniond& before) {
-  return last * before.conjugate() * last;
-}
-
-// The rotation common/'s polar_rotation returns (to 1e-12 per entry, the tests), by Newton
-// from q where it decides, and by common/'s SVD where it does not (then ++fallbacks). q
-// holds the answer on exit, the next step's warm start.
-Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
-                                    long long& fallbacks);
-
-// The ten distinct blocks K_ab, a <= b, of K = R K0 R^T = -df/dx_e in closed form, with
-// r_a = R g_a (columns of r) and K0 never formed:
-//   K_ab = V [mu (r_a . r_b) I + mu r_b r_a^T + lambda r_a r_b^T],  K_ba = K_ab^T.
-// The scale s multiplies both Lame terms (the fused pass passes h beta + h^2).
-constexpr std::array<std::array<int, 2>, 10> kUpperPairs = {
-    {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1}, {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}}};
-void stiffness_blocks(const Eigen::Matrix<double, 3, 4>& r, double mu_volume,
-                      double lambda_volume, std::array<Eigen::Matrix3d, 10>& K);
-
-// r_a = R g_a, the rotated shape gradients, for a = 0..3.
-Eigen::Matrix<double, 3, 4> rotated_gradients(const Eigen::Matrix3d& R,
-                                              const Eigen::Matrix3d& Dm_inv);
-
-// ---- the block sparse matrix -----------------------------------------------------
-
-// Block compressed-row storage: row i (node i) holds blocks row_start[i] .. row_start[i+1]-1,
-// block k is blocks[k] at block column column[k], columns sorted within a row.
-struct BlockSparseMatrix {
-  std::vector<int> row_start;
-  std::vector<int> column;
-  std::vector<Eigen::Matrix3d> blocks;
-
-  BlockSparseMatrix() = default;
-  // The pattern of a symmetric node adjacency (each row sorted, the node itself included).
-  explicit BlockSparseMatrix(const std::vector<std::vector<int>>& adjacency);
-
-  int block_rows() const { return static_cast<int>(row_start.size()) - 1; }
-  // Index of block (i, j) in blocks, found by a binary search: for set-up only.
-  int find(int i, int j) const;
-  // y = A x, one row of blocks at a time: y_i = sum_j A_ij x_j, each y_i written once.
-  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  // y = A x reading only the blocks with j >= i (A must be symmetric): y_i += A_ij x_j and
-  // y_j += A_ij^T x_i. Half the blocks read, but y is scattered.
-  void multiply_upper(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
-  // The same matrix with only the blocks j >= i: symmetric storage.
-  BlockSparseMatrix upper() const;
-  // Conversion for tests and comparisons (allocates).
-  Eigen::SparseMatrix<double> to_sparse() const;
-};
-
-// The work vectors of the PCG, sized on the first solve and reused afterwards.
-struct PcgWorkspace {
-  Eigen::VectorXd residual, preconditioned, direction, product;
-  std::vector<Eigen::Matrix3d> inverse_diagonal;  // block Jacobi: (A_ii)^-1
-};
-
-struct PcgResult {
-  int iterations = 0;
-  double relative_residual = 0.0;  // ||b - A y|| / ||b||, as Eigen's error()
-  bool converged = false;
-};
-
-// Block-Jacobi preconditioned CG on the filtered block system, with the same stopping rule
-// and PPCG filter as chapter 06. y holds the initial guess on entry and the solution on exit.
-PcgResult pcg_solve(const BlockSparseMatrix& A, const std::vector<int>& diagonal_block,
-                    const Eigen::VectorXd& b, const std::vector<NodeConstraint>& constraints,
-                    const SolverSettings& settings, PcgWorkspace& work, Eigen::VectorXd& y);
-
-class ElementKernelsStepper final : public Stepper {
+// Chapter 09 derives from this stepper and replaces its three marked phases.
+class ElementKernelsStepper : public Stepper {
  public:
   ElementKernelsStepper(const Scene& scene, const SolverSettings& settings);
   void step(State& state) override;
@@ -119,21 +33,17 @@ class ElementKernelsStepper final : public Stepper {
   // The last step's filtered system S A S^T + I - S and right-hand side S (b - A z).
   const BlockSparseMatrix& system_matrix() const { return A_; }
   const Eigen::VectorXd& system_rhs() const { return filtered_b_; }
-  const std::vector<int>& diagonal_blocks() const { return diagonal_block_; }
-  // Per element, the rotations of the last two steps (the next step's warm start).
-  const std::vector<Eigen::Quaterniond>& rotations() const { return rotations_; }
-  const std::vector<Eigen::Quaterniond>& previous_rotations() const { return previous_rotations_; }
-  const std::vector<ElementShape>& shapes() const { return shapes_; }
-  // Elements whose rotation came from the SVD because Newton could not decide: in the
-  // last step, and in all steps so far.
-  long long last_step_fallbacks() const { return last_step_fallbacks_; }
-  long long total_fallbacks() const { return total_fallbacks_; }
+  const std::vector<int>& diagonal_blocks() const { return index_.diagonal; }
+  // The element loop's shapes, rotations and fallback counts.
+  const FusedElements& elements() const { return elements_; }
 
- private:
-  void start_system(const State& state);
-  void element_pass(const State& state);
-  void apply_constraints(const State& state);
-  void solve();
+ protected:
+  // What the elements do not touch: A = (1 + h alpha) M, b = h (f_gravity - alpha M v + f_ext).
+  virtual void start_system(const State& state);
+  // The fused pass: rotations, forces and the blocks of df/dx, written into A and b.
+  virtual void element_pass(const State& state);
+  // y = the filtered system's solution (warm-started from the last one), dv = y + z.
+  virtual void solve();
 
   Scene scene_;
   Model model_;
@@ -141,20 +51,14 @@ class ElementKernelsStepper final : public Stepper {
   StepProfile profile_;
   bool warned_not_converged_ = false;
 
-  std::vector<ElementShape> shapes_;
-  std::vector<Eigen::Quaterniond> rotations_;           // R_e of the last step
-  std::vector<Eigen::Quaterniond> previous_rotations_;  // R_e of the step before
-  bool first_step_ = true;
-  long long last_step_fallbacks_ = 0, total_fallbacks_ = 0;
-  std::vector<std::array<int, 16>> element_blocks_;  // per element: block of (a, b) in A
-  BlockSparseMatrix A_;               // M - h df/dv - h^2 df/dx, the mesh's block pattern
-  std::vector<int> diagonal_block_;   // per node: index of block (i, i)
-  std::vector<int> transpose_block_;  // per block (i, j): index of block (j, i)
-  Eigen::VectorXd b_;                 // h (f + h df/dx v)
-  Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
-  Eigen::VectorXd filtered_b_;        // S (b - A z)
+  FusedElements elements_;
+  BlockSparseMatrix A_;  // M - h df/dv - h^2 df/dx, the mesh's block pattern
+  BlockIndex index_;     // where element, diagonal and transposed blocks sit in A_
+  Eigen::VectorXd b_;           // h (f + h df/dx v)
+  Eigen::VectorXd z_;           // prescribed velocity change of constrained dofs
+  Eigen::VectorXd filtered_b_;  // S (b - A z)
   Eigen::VectorXd dv_;
-  PcgWorkspace pcg_;
+  ch07::PcgWorkspace pcg_;
   Eigen::VectorXd y_;  // the unknown of the filtered system, dv = y + z: also the warm start
 };
 

@@ -14,13 +14,6 @@
 
 namespace fem::ch10 {
 
-template <int R, int C>
-int BlockCsr<R, C>::find(int i, int j) const {
-  const auto first = column.begin() + row_start[i], last = column.begin() + row_start[i + 1];
-  const auto it = std::lower_bound(first, last, j);
-  return (it != last && *it == j) ? static_cast<int>(it - column.begin()) : -1;
-}
-
 namespace {
 
 using Matrix6d = Eigen::Matrix<double, kModes, kModes>;
@@ -30,31 +23,6 @@ using Rows = std::vector<std::vector<int>>;  // a pattern under construction: co
 void sort_unique(std::vector<int>& v) {
   std::sort(v.begin(), v.end());
   v.erase(std::unique(v.begin(), v.end()), v.end());
-}
-
-template <int R, int C>
-BlockCsr<R, C> from_rows(const Rows& rows) {
-  BlockCsr<R, C> m;
-  for (const auto& row : rows) {
-    m.column.insert(m.column.end(), row.begin(), row.end());
-    m.row_start.push_back(static_cast<int>(m.column.size()));
-  }
-  m.blocks.assign(m.column.size(), BlockCsr<R, C>::Block::Zero());
-  return m;
-}
-
-template <int R, int C, class Values>
-Eigen::SparseMatrix<double> to_sparse(const BlockCsr<R, C>& pattern, const Values* values,
-                                      int cols) {
-  std::vector<Eigen::Triplet<double>> t;
-  for (int i = 0; i < pattern.block_rows(); ++i)
-    for (int k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k)
-      for (int r = 0; r < R; ++r)
-        for (int c = 0; c < C; ++c)
-          t.emplace_back(R * i + r, C * pattern.column[k] + c, values[k](r, c));
-  Eigen::SparseMatrix<double> m(R * pattern.block_rows(), cols);
-  m.setFromTriplets(t.begin(), t.end());
-  return m;
 }
 
 // Standard aggregation (Vanek, Mandel & Brezina 1996; PyAMG's standard_aggregation) with
@@ -201,7 +169,7 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
       rows[i].push_back(fine.aggregate[i]);
     sort_unique(rows[i]);
   }
-  fine.P = from_rows<B, kModes>(rows);
+  fine.P = BlockCsr<B, kModes>(rows);
   fine.tentative_block.resize(n);
   for (int i = 0; i < n; ++i) {
     fine.tentative_block[i] = fine.P.find(i, fine.aggregate[i]);
@@ -221,7 +189,7 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
         rows[i].push_back(P.column[m]);
     sort_unique(rows[i]);
   }
-  fine.AP = from_rows<B, kModes>(rows);
+  fine.AP = BlockCsr<B, kModes>(rows);
   fine.ap_target.clear();
   for (int i = 0; i < n; ++i)
     for (int k = A.row_start[i]; k < A.row_start[i + 1]; ++k)
@@ -238,7 +206,7 @@ void build_transfer(Level<B>& fine, const std::vector<Eigen::Matrix<double, B, k
       for (int q = AP.row_start[i]; q < AP.row_start[i + 1]; ++q)
         coarse_rows[P.column[m]].push_back(AP.column[q]);
   for (auto& row : coarse_rows) sort_unique(row);
-  coarse.A = from_rows<kModes, kModes>(coarse_rows);
+  coarse.A = BlockCsr<kModes, kModes>(coarse_rows);
   coarse.values = coarse.A.blocks.data();
   fine.galerkin_first.resize(P.column.size());
   fine.galerkin_target.clear();
@@ -584,16 +552,16 @@ long long Multigrid::prolongator_blocks(int level) const {
 }
 
 Eigen::SparseMatrix<double> Multigrid::level_matrix(int level) const {
-  if (level == 0) return to_sparse(fine_.A, fine_.values, fine_.dofs());
+  if (level == 0) return fine_.A.to_sparse(fine_.values, fine_.dofs());
   const auto& l = coarse_.at(level - 1);
-  return to_sparse(l.A, l.values, l.dofs());
+  return l.A.to_sparse(l.values, l.dofs());
 }
 
 Eigen::SparseMatrix<double> Multigrid::prolongator(int level) const {
   const int coarse_dofs = level_dofs(level + 1);
-  if (level == 0) return to_sparse(fine_.P, fine_.P.blocks.data(), coarse_dofs);
+  if (level == 0) return fine_.P.to_sparse(coarse_dofs);
   const auto& l = coarse_.at(level - 1);
-  return to_sparse(l.P, l.P.blocks.data(), coarse_dofs);
+  return l.P.to_sparse(coarse_dofs);
 }
 
 Eigen::VectorXd Multigrid::unused_modes(int level) const {

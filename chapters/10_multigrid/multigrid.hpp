@@ -9,7 +9,7 @@
 // only numbers on those fixed patterns, and apply(r, z) is one V-cycle. Neither allocates.
 //
 // The multigrid knows nothing of the stepper: it reads the fine matrix as block compressed
-// rows (row_start, column, blocks), the layout of the stepper's BlockSparseMatrix.
+// rows (row_start, column, blocks), the layout of chapter 07's BlockSparseMatrix.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -18,23 +18,14 @@
 #include <array>
 #include <vector>
 
+#include "chapters/07_block_sparse/block_sparse.hpp"
 #include "common/scene.hpp"
 
 namespace fem::ch10 {
 
-// Block compressed rows with R x C blocks: row i holds blocks row_start[i]..row_start[i+1]-1,
-// block k sits at block column column[k]; columns sorted within a row.
-template <int R, int C>
-struct BlockCsr {
-  using Block = Eigen::Matrix<double, R, C>;
-  std::vector<int> row_start{0};
-  std::vector<int> column;
-  std::vector<Block> blocks;
-
-  int block_rows() const { return static_cast<int>(row_start.size()) - 1; }
-  // Index of block (i, j), by binary search: set-up only. -1 if absent.
-  int find(int i, int j) const;
-};
+// The hierarchy's matrices are chapter 07's block compressed rows, with 6x6 blocks on the
+// aggregates and 3x6 blocks in the prolongators.
+using ch07::BlockCsr;
 
 // Every coarse unknown is one aggregate of nodes carrying 6 near-null-space modes.
 constexpr int kModes = 6;

@@ -87,9 +87,10 @@ TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thr
   Eigen::VectorXd first;
   for (const int threads : thread_counts()) {
     const ThreadCountScope scope(threads);
-    ch09::ParallelPcg pcg(A, stepper.diagonal_blocks(), scene.constraints);
+    ch09::ParallelPcg pcg(A, scene.constraints);
+    ch09::BlockJacobi block_jacobi(stepper.diagonal_blocks());
     Eigen::VectorXd y = Eigen::VectorXd::Zero(b.size()), Ay(b.size());
-    const ch09::PcgResult result = pcg.solve(A, b, test::tight_solver(), y);
+    const SolveStats result = pcg.solve(A, block_jacobi, b, test::tight_solver(), y);
     A.multiply(y, Ay);
     INFO(threads << " threads: " << result.iterations << " iterations");
     CHECK(result.converged);

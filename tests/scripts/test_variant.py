@@ -66,6 +66,19 @@ def main():
               (variant / "README.md").read_text().startswith(
                   "# Chapter 06_my_fused_updates: a variant of 06_custom_pcg ("))
 
+        # The hand-in: the variant's change against its original with the copy's renames undone.
+        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo, "--variant",
+                "06_my_fused_updates")
+        check("an unchanged variant's diff is empty (renames undone)", p.returncode == 0
+              and p.stdout == "", p.stdout[:2000] + p.stderr)
+        (variant / "stepper.cpp").write_text(cpp.replace("namespace {", "namespace {  // changed", 1))
+        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo, "--variant",
+                "06_my_fused_updates")
+        check("a one-line change is one hunk of one line", p.returncode == 0
+              and p.stdout.count("\n@@") + p.stdout.startswith("@@") == 1
+              and p.stdout.count("\n+namespace {  // changed") == 1, p.stdout[:2000] + p.stderr)
+        (variant / "stepper.cpp").write_text(cpp)
+
         # Refusals, with the reason.
         for bad, reason in ((["06", "my_fused_updates"], "exists already"),
                             (["99", "x"], "no chapter 99"),
@@ -86,10 +99,11 @@ def main():
         text = generated.read_text() if generated.exists() else ""
         check("the variant is registered with its original",
               'chapter<fem::ch06_my_fused_updates::CustomPcgStepper>("06_my_fused_updates", '
-              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg"),' in text, text)
+              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg", nullptr),' in text, text)
         check("the originals keep their entries",
               'chapter<fem::ch06::CustomPcgStepper>("06_custom_pcg"' in text
-              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "")' in text, text)
+              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "", nullptr)' in text
+              and '"", &fem::ch08::lessons)' in text, text)
 
         # Original and variant compile side by side (no clash of names), the variant's own file too.
         flags = ["-std=c++17", "-fsyntax-only", f"-I{repo}", *[f"-I{i}" for i in args.include],

@@ -1,15 +1,16 @@
-// fem_multigrid: the measurements behind chapter 10's lesson, on one scene.
+// Chapter 10's lesson table: `fem_lessons multigrid`, the measurements behind the lesson on
+// one scene.
 //  - runs chapter 10 for some steps with the multigrid settings given (modes, smoother,
 //    sweeps, prolongator) and reports median PCG iterations and solve time per step;
 //  - on the last step's filtered system: the hierarchy (levels, unknowns, blocks), the cost
 //    of prepare() and of one V-cycle in SpMV-equivalents, and PCG from a zero guess with the
 //    V-cycle, with chapter 09's block Jacobi and with Eigen's IncompleteCholesky CG;
-//  - with --readme FILE: those numbers as a table between the markers
-//    <!-- multigrid-table:begin/end --> of FILE (the chapter's README);
 //  - with --export DIR: that system as Matrix Market (A.mtx, b.mtx, the filtered rigid-body
 //    modes B.mtx) and summary.json, for scripts/pyamg_reference.py.
+// The report goes to stderr, the table (for --readme) to stdout.
+#include "chapters/10_multigrid/lesson.hpp"
+
 #include <Eigen/IterativeLinearSolvers>
-#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -17,53 +18,27 @@
 #include <iostream>
 #include <sstream>
 #include <string>
-#include <ctime>
 #include <unsupported/Eigen/SparseExtra>
 #include <vector>
 
-#include "chapters/09_threads/stepper.hpp"
+#include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
-#include "common/cli.hpp"
-#include "common/model.hpp"
+#include "common/threads.hpp"
+
+namespace fem::ch10 {
 
 namespace {
 
-using namespace fem;
 using Clock = std::chrono::steady_clock;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-double thread_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-// Median CPU milliseconds of this thread over `repeat` runs of f: on a shared machine the
-// wall clock of a long run also counts the other processes' time slices, the CPU time does
-// not, so the ratios between short and long operations stay meaningful.
-template <class F>
-double time_ms(int repeat, F&& f) {
-  std::vector<double> ms;
-  for (int k = 0; k < repeat; ++k) {
-    const double start = thread_seconds();
-    f();
-    ms.push_back(1e3 * (thread_seconds() - start));
-  }
-  return median(ms);
-}
-
-ch10::MultigridSettings multigrid_from_args(const ArgParser& args) {
-  ch10::MultigridSettings s;
+MultigridSettings multigrid_from_args(const ArgParser& args) {
+  MultigridSettings s;
   s.modes = args.get_int("modes");
   const std::string smoother = args.get("smoother");
   if (smoother == "gs")
-    s.smoother = ch10::MultigridSettings::Smoother::GaussSeidel;
+    s.smoother = MultigridSettings::Smoother::GaussSeidel;
   else if (smoother == "jacobi")
-    s.smoother = ch10::MultigridSettings::Smoother::Jacobi;
+    s.smoother = MultigridSettings::Smoother::Jacobi;
   else
     throw UsageError("--smoother must be gs or jacobi");
   s.sweeps = args.get_int("sweeps");
@@ -96,21 +71,21 @@ Eigen::MatrixXd rigid_body_modes(const Scene& scene) {
   return B;
 }
 
-int run(const ArgParser& args) {
-  const int threads = threads_from_args(args);
-  const Scene scene = scene_from_args(args);
+std::string multigrid_table(const LessonRun& run) {
+  const ArgParser& args = run.args;
+  const int threads = max_threads();
+  const Scene& scene = run.scene;
   const SolverSettings solver = solver_from_args(args);
-  const ch10::MultigridSettings settings = multigrid_from_args(args);
-  const int steps = args.get_int("steps");
-  if (steps <= 0) throw UsageError("--steps must be positive");
+  const MultigridSettings settings = multigrid_from_args(args);
+  const int steps = run.steps;
 
-  std::cout << "fem_multigrid: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
+  std::cerr << "fem_lessons multigrid: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes), " << steps << " steps, tol "
             << solver.tolerance << ", modes " << settings.modes << ", smoother "
             << args.get("smoother") << " x" << settings.sweeps << ", prolongator "
             << args.get("prolongator") << ", " << threads << " thread(s)\n";
   const auto setup_start = Clock::now();
-  ch10::MultigridStepper stepper(scene, solver, settings);
+  MultigridStepper stepper(scene, solver, settings);
   const double setup_ms = 1e3 * std::chrono::duration<double>(Clock::now() - setup_start).count();
   State state = rest_state(scene);
   std::vector<double> iterations, solve_ms, step_ms;
@@ -118,37 +93,36 @@ int run(const ArgParser& args) {
     stepper.step(state);
     const StepProfile& p = stepper.profile();
     if (const char* why = divergence(state, p)) {
-      std::cerr << "fem_multigrid: diverged at step " << k + 1 << ": " << why << "\n";
-      return 1;
+      throw std::runtime_error("diverged at step " + std::to_string(k + 1) + ": " + why);
     }
     iterations.push_back(p.cg_iterations);
     solve_ms.push_back(1e3 * p.solve.seconds);
     step_ms.push_back(1e3 * p.step.seconds);
     if ((k + 1) % std::max(1, steps / 4) == 0)
-      std::cout << "  step " << k + 1 << "/" << steps << "\n" << std::flush;
+      std::cerr << "  step " << k + 1 << "/" << steps << "\n" << std::flush;
   }
 
-  ch10::Multigrid& mg = stepper.multigrid();
-  const ch10::BlockSparseMatrix& A = stepper.system_matrix();
+  Multigrid& mg = stepper.multigrid();
+  const ch07::BlockSparseMatrix& A = stepper.system_matrix();
   const Eigen::VectorXd& b = stepper.system_rhs();
-  std::cout << "\nhierarchy (set-up " << std::fixed << std::setprecision(1) << setup_ms
+  std::cerr << "\nhierarchy (set-up " << std::fixed << std::setprecision(1) << setup_ms
             << " ms for the whole stepper)\n";
   long long blocks = 0, fine_blocks = 0;
   for (int l = 0; l < mg.levels(); ++l) {
     const int block = l == 0 ? 3 : 6;
-    std::cout << "  level " << l << ": " << std::setw(7) << mg.level_dofs(l) << " unknowns, "
+    std::cerr << "  level " << l << ": " << std::setw(7) << mg.level_dofs(l) << " unknowns, "
               << std::setw(8) << mg.level_blocks(l) << " blocks of " << block << "x" << block;
     if (l + 1 < mg.levels())
-      std::cout << ", P " << std::setw(7) << mg.prolongator_blocks(l) << " blocks of " << block
+      std::cerr << ", P " << std::setw(7) << mg.prolongator_blocks(l) << " blocks of " << block
                 << "x6";
-    std::cout << "\n";
+    std::cerr << "\n";
     blocks += mg.level_blocks(l) * block * block;
     if (l == 0) fine_blocks = blocks;
   }
-  std::cout << "  operator complexity (stored entries, all levels / finest): " << std::setprecision(2)
+  std::cerr << "  operator complexity (stored entries, all levels / finest): " << std::setprecision(2)
             << static_cast<double>(blocks) / fine_blocks << "\n";
 
-  std::cout << "measuring the last system: V-cycle, PCG with three preconditioners\n"
+  std::cerr << "measuring the last system: V-cycle, PCG with three preconditioners\n"
             << std::flush;
   const int repeat = 20;
   Eigen::VectorXd x = Eigen::VectorXd::Ones(b.size()), y(b.size());
@@ -157,23 +131,20 @@ int run(const ArgParser& args) {
   const double vcycle = time_ms(10 * repeat, [&] { mg.apply(b, y); });
 
   // PCG from zero on the same system: the V-cycle, block Jacobi, Eigen's IC.
-  ch10::ParallelPcg pcg(A, scene.constraints);
+  ch09::ParallelPcg pcg(A, scene.constraints);
+  VCyclePreconditioner v_cycle(mg);
   Eigen::VectorXd y10 = Eigen::VectorXd::Zero(b.size());
-  const ch10::PcgResult r10 = pcg.solve(A, mg, b, solver, y10);
+  const SolveStats r10 = pcg.solve(A, v_cycle, b, solver, y10);
   const double pcg10 = time_ms(5, [&] {
     y10.setZero();
-    pcg.solve(A, mg, b, solver, y10);
+    pcg.solve(A, v_cycle, b, solver, y10);
   });
-  ch09::BlockSparseMatrix A9;
-  A9.row_start = A.row_start;
-  A9.column = A.column;
-  A9.blocks = A.blocks;
-  ch09::ParallelPcg pcg9(A9, stepper.diagonal_blocks(), scene.constraints);
+  ch09::BlockJacobi block_jacobi(stepper.diagonal_blocks());
   Eigen::VectorXd y9 = Eigen::VectorXd::Zero(b.size());
-  const ch09::PcgResult r9 = pcg9.solve(A9, b, solver, y9);
+  const SolveStats r9 = pcg.solve(A, block_jacobi, b, solver, y9);
   const double pcg9_ms = time_ms(5, [&] {
     y9.setZero();
-    pcg9.solve(A9, b, solver, y9);
+    pcg.solve(A, block_jacobi, b, solver, y9);
   });
   const Eigen::SparseMatrix<double> csc = A.to_sparse();
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
@@ -187,7 +158,7 @@ int run(const ArgParser& args) {
     yic = ic.solve(b);
   });
 
-  std::cout << std::setprecision(3) << "\nchapter 10 over " << steps
+  std::cerr << std::setprecision(3) << "\nchapter 10 over " << steps
             << " steps (warm start): median iterations " << median(iterations)
             << ", median solve " << median(solve_ms) << " ms, median step " << median(step_ms)
             << " ms\n"
@@ -196,7 +167,7 @@ int run(const ArgParser& args) {
             << std::setprecision(3) << vcycle << " ms (" << std::setprecision(1) << vcycle / spmv
             << " SpMV)\n"
             << std::setprecision(3) << "PCG from zero, tol " << std::defaultfloat << solver.tolerance << std::fixed
-            << " (CPU ms of this thread):\n"
+            << " (ms):\n"
             << "  V-cycle (chapter 10)          " << std::setw(5) << r10.iterations
             << " iterations, " << pcg10 << " ms (plus prepare)\n"
             << "  block Jacobi (chapter 09)     " << std::setw(5) << r9.iterations
@@ -204,10 +175,11 @@ int run(const ArgParser& args) {
             << "  Eigen IncompleteCholesky CG   " << std::setw(5) << ic.iterations()
             << " iterations, " << ic_ms << " ms (compute + solve)\n";
 
-  if (const std::string readme = args.get("readme"); !readme.empty()) {
+  std::string table;
+  {
     std::ostringstream t;
     t << std::fixed << std::setprecision(1);
-    t << "| `" << std::filesystem::path(scene.mesh.file).filename().string() << "`, "
+    t << "| `" << mesh_name(scene) << "`, "
       << scene.name << ", " << steps << " steps, " << threads << " thread(s) | value |\n"
       << "| --- | ---: |\n";
     for (int l = 0; l < mg.levels(); ++l)
@@ -218,20 +190,19 @@ int run(const ArgParser& args) {
       << " / " << median(step_ms) << " |\n"
       << "| `prepare`, in SpMV-equivalents | " << std::setprecision(1) << prepare / spmv << " |\n"
       << "| one V-cycle, in SpMV-equivalents | " << vcycle / spmv << " |\n"
-      << "| last system from zero: V-cycle PCG, iterations (CPU ms, plus `prepare`) | "
+      << "| last system from zero: V-cycle PCG, iterations (ms, plus `prepare`) | "
       << r10.iterations << " (" << std::setprecision(2) << pcg10 << " + " << prepare << ") |\n"
-      << "| last system from zero: block-Jacobi PCG of the chapter before, iterations (CPU ms) | "
+      << "| last system from zero: block-Jacobi PCG of the chapter before, iterations (ms) | "
       << r9.iterations << " (" << pcg9_ms << ") |\n"
-      << "| last system from zero: Eigen IncompleteCholesky CG, iterations (CPU ms, compute + solve) | "
+      << "| last system from zero: Eigen IncompleteCholesky CG, iterations (ms, compute + solve) | "
       << ic.iterations() << " (" << ic_ms << ") |\n\n"
       << "Tolerance " << std::defaultfloat << solver.tolerance
-      << "; SpMV is one block product with the finest matrix, times are CPU ms of the thread "
-         "(median of repeats). Generated by `fem_multigrid";
+      << "; SpMV is one block product with the finest matrix, times are wall-clock ms "
+         "(median of repeats). Generated by `fem_lessons multigrid";
     for (const char* option : {"mesh", "steps", "threads"})
       if (!args.get(option).empty()) t << " --" << option << " " << args.get(option);
     t << " --readme`.\n";
-    write_between_markers(readme, "multigrid-table", t.str());
-    std::cout << "wrote " << readme << "\n";
+    table = t.str();
   }
   if (const std::string dir = args.get("export"); !dir.empty()) {
     std::filesystem::create_directories(dir);
@@ -240,25 +211,20 @@ int run(const ArgParser& args) {
                            dir + "/B.mtx"))
       throw std::runtime_error("cannot write Matrix Market files into '" + dir + "'");
     std::ofstream(dir + "/summary.json")
-        << "{\"mesh\": \"" << std::filesystem::path(scene.mesh.file).filename().string()
+        << "{\"mesh\": \"" << mesh_name(scene)
         << "\", \"scene\": \"" << scene.name << "\", \"nodes\": " << scene.mesh.num_nodes()
         << ", \"tolerance\": " << std::defaultfloat << solver.tolerance << ", \"ours_iterations\": " << r10.iterations
         << ", \"block_jacobi_iterations\": " << r9.iterations
         << ", \"ours_levels\": " << mg.levels() << "}\n";
-    std::cout << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
+    std::cerr << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
   }
-  return r10.converged ? 0 : 1;
+  if (!r10.converged) throw std::runtime_error("the V-cycle PCG did not converge on the last system");
+  return table;
 }
 
-}  // namespace
 
-int main(int argc, char** argv) {
-  ArgParser args("fem_multigrid",
-                 "Chapter 10's multigrid on one scene: iterations, hierarchy, V-cycle cost, "
-                 "PCG against block Jacobi and Eigen's IncompleteCholesky; exports the system.");
-  add_scene_options(args, "meshes/plate_poster.msh");
+void add_multigrid_options(ArgParser& args) {
   add_solver_options(args);
-  args.option("steps", "N", "steps to run before measuring the last system", "20");
   args.option("modes", "N", "near-null-space modes per aggregate: 6 or 3 (translations)", "6");
   args.option("smoother", "NAME", "gs (symmetric block Gauss-Seidel) or jacobi", "gs");
   args.option("sweeps", "N", "pre- and post-smoothing sweeps", "1");
@@ -268,18 +234,16 @@ int main(int argc, char** argv) {
               "frozen");
   args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns", "200");
   args.option("coarse-every", "K", "recompute the coarse matrices every K-th step", "1");
-  add_thread_option(args);
-  args.option("readme", "FILE", "also write the table between the multigrid-table markers of FILE",
-              "");
   args.option("export", "DIR", "write the last filtered system as Matrix Market into DIR", "");
-  try {
-    if (!args.parse(argc, argv)) return 0;
-    return run(args);
-  } catch (const UsageError& e) {
-    std::cerr << "fem_multigrid: " << e.what() << " (see fem_multigrid --help)\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "fem_multigrid: error: " << e.what() << "\n";
-    return 1;
-  }
 }
+
+}  // namespace
+
+std::vector<Lesson> lessons() {
+  return {{"multigrid",
+           "the hierarchy, iterations, prepare and V-cycle cost; PCG against block Jacobi and IC",
+           "meshes/plate_poster.msh", add_multigrid_options,
+           [](const LessonRun& run) { return multigrid_table(run); }}};
+}
+
+}  // namespace fem::ch10

@@ -1,0 +1,226 @@
+// Chapter 09's parallel PCG: one parallel region per solve, one `omp for` over the fixed
+// chunks per step of the iteration, sums in chunk order.
+#include "chapters/09_threads/parallel_pcg.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "chapters/09_threads/parallel.hpp"
+
+namespace fem::ch09 {
+
+RowChunks::RowChunks(const BlockSparseMatrix& pattern) {
+  // Equal numbers of blocks rather than of rows: the SpMV, the largest loop, costs per
+  // block. The boundaries depend on the pattern only.
+  // Fewer chunks on a small mesh (at least kMinRows rows each), where a chunk's fixed cost
+  // would show; still a function of the mesh alone.
+  const int rows = pattern.block_rows();
+  const int count = std::clamp(rows / kMinRows, 1, kMaxCount);
+  const long long blocks = pattern.row_start.back();
+  start.assign(count + 1, rows);
+  start[0] = 0;
+  int i = 0;
+  for (int c = 1; c < count; ++c) {
+    const long long target = blocks * c / count;
+    while (i < rows && pattern.row_start[i] < target) ++i;
+    start[c] = i;
+  }
+}
+
+double sum_in_order(const std::vector<double>& partial) {
+  double sum = 0.0;
+  for (const double p : partial) sum += p;
+  return sum;
+}
+
+// ---- preconditioners --------------------------------------------------------------------
+
+void Preconditioner::apply_rows(int, int, const Eigen::VectorXd&, Eigen::VectorXd&) const {}
+
+void Preconditioner::apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) {
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks.count(); ++c) apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
+}
+
+BlockJacobi::BlockJacobi(const std::vector<int>& diagonal_block)
+    : diagonal_block_(diagonal_block), inverse_diagonal_(diagonal_block.size()) {}
+
+void BlockJacobi::prepare(const BlockSparseMatrix& A, const RowChunks& chunks) {
+  // The diagonal blocks of the filtered matrix are symmetric positive definite (a fixed
+  // node's is the identity): a fixed-size 3x3 inverse each.
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks.count(); ++c)
+    for (int i = chunks.start[c]; i < chunks.start[c + 1]; ++i)
+      inverse_diagonal_[i] = A.blocks[diagonal_block_[i]].inverse();
+}
+
+void BlockJacobi::apply_rows(int first, int last, const Eigen::VectorXd& r,
+                             Eigen::VectorXd& s) const {
+  for (int i = first; i < last; ++i)
+    s.segment<3>(3 * i).noalias() = inverse_diagonal_[i] * r.segment<3>(3 * i);
+}
+
+// ---- the solver ---------------------------------------------------------------------------
+
+ParallelPcg::ParallelPcg(const BlockSparseMatrix& pattern,
+                         const std::vector<NodeConstraint>& constraints)
+    : chunks_(pattern), constraints_(constraints) {  // a copy: no reference into a scene
+  // The constraints of each chunk, in node order.
+  std::stable_sort(constraints_.begin(), constraints_.end(),
+                   [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+  constraint_start_.assign(chunks_.count() + 1, 0);
+  for (int c = 0, k = 0; c < chunks_.count(); ++c) {
+    while (k < static_cast<int>(constraints_.size()) && constraints_[k].node < chunks_.start[c + 1])
+      ++k;
+    constraint_start_[c + 1] = k;
+  }
+  for (auto* partial : {&partial_bb_, &partial_pq_, &partial_rr_, &partial_rs_})
+    partial->assign(chunks_.count(), 0.0);
+}
+
+SolveStats ParallelPcg::solve(const BlockSparseMatrix& A, Preconditioner& M,
+                              const Eigen::VectorXd& b, const SolverSettings& settings,
+                              Eigen::VectorXd& y) {
+  for (Eigen::VectorXd* v : {&r_, &s_, &p_, &q_}) v->resize(b.size());  // allocates once
+  SolveStats result;
+  run_parallel([&] {
+    // Everything below runs on every thread. The scalars (norms, rho, the step) are each
+    // thread's own copy, added up from the same partial sums in the same order: equal on
+    // every thread, so every thread takes the same branches.
+    M.prepare(A, chunks_);
+    const double rhs_norm2 = filter_guess(b, y);
+    const SolveStats stats = iterate(A, M, b, rhs_norm2, settings, y);
+#pragma omp master
+    result = stats;
+  });
+  return result;
+}
+
+SolveStats ParallelPcg::iterate(const BlockSparseMatrix& A, Preconditioner& M,
+                                const Eigen::VectorXd& b, double rhs_norm2,
+                                const SolverSettings& settings, Eigen::VectorXd& y) {
+  SolveStats stats;
+  if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
+#pragma omp for schedule(static)
+    for (int c = 0; c < chunks_.count(); ++c) y.segment(chunks_.first_dof(c), chunks_.dofs(c)).setZero();
+    stats.converged = true;
+    return stats;
+  }
+  const double threshold = std::max(settings.tolerance * settings.tolerance * rhs_norm2,
+                                    std::numeric_limits<double>::min());
+  // p = S M r; a block-diagonal M was applied inside residual().
+  double residual_norm2 = residual(A, M, b, y);
+  double rho = 0.0;
+  if (M.block_diagonal())
+    rho = sum_in_order(partial_rs_);
+  else if (residual_norm2 >= threshold)
+    rho = precondition(M, p_);
+  while (residual_norm2 >= threshold && stats.iterations < settings.max_iterations) {
+    const double step = rho / product(A);
+    // An overflowing system (an absurd E) overflows here: stop before y does, with a
+    // residual that says so, rather than iterate on NaN up to the cap. Every thread sees
+    // the same step, so every thread stops.
+    if (!std::isfinite(step)) {
+      residual_norm2 = std::numeric_limits<double>::quiet_NaN();
+      break;
+    }
+    residual_norm2 = update(M, step, y);
+    ++stats.iterations;
+    if (residual_norm2 < threshold) break;
+    const double rho_old = rho;
+    rho = M.block_diagonal() ? sum_in_order(partial_rs_) : precondition(M, s_);
+    next_direction(rho / rho_old);
+  }
+  stats.relative_residual = std::sqrt(residual_norm2 / rhs_norm2);
+  stats.converged = residual_norm2 < threshold;
+  return stats;
+}
+
+void ParallelPcg::filter(int c, Eigen::VectorXd& v) const {
+  for (int k = constraint_start_[c]; k < constraint_start_[c + 1]; ++k) {
+    const NodeConstraint& constraint = constraints_[k];
+    v.segment<3>(3 * constraint.node) = constraint.filter * v.segment<3>(3 * constraint.node);
+  }
+}
+
+void ParallelPcg::precondition_chunk(const Preconditioner& M, int c, Eigen::VectorXd& s) {
+  M.apply_rows(chunks_.start[c], chunks_.start[c + 1], r_, s);
+  filter(c, s);
+  partial_rs_[c] = r_.segment(chunks_.first_dof(c), chunks_.dofs(c))
+                       .dot(s.segment(chunks_.first_dof(c), chunks_.dofs(c)));
+}
+
+double ParallelPcg::filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y) {
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    filter(c, y);
+    partial_bb_[c] = b.segment(chunks_.first_dof(c), chunks_.dofs(c)).squaredNorm();
+  }
+  return sum_in_order(partial_bb_);
+}
+
+double ParallelPcg::residual(const BlockSparseMatrix& A, const Preconditioner& M,
+                             const Eigen::VectorXd& b, const Eigen::VectorXd& y) {
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
+    A.multiply_rows(y, q_, chunks_.start[c], chunks_.start[c + 1]);
+    r_.segment(first, size) = b.segment(first, size) - q_.segment(first, size);
+    filter(c, r_);
+    if (M.block_diagonal()) precondition_chunk(M, c, p_);
+    partial_rr_[c] = r_.segment(first, size).squaredNorm();
+  }
+  return sum_in_order(partial_rr_);
+}
+
+double ParallelPcg::precondition(Preconditioner& M, Eigen::VectorXd& s) {
+  // M reads r of every row: it starts after the barrier that ended r's update.
+  M.apply(chunks_, r_, s);
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    filter(c, s);
+    partial_rs_[c] = r_.segment(chunks_.first_dof(c), chunks_.dofs(c))
+                         .dot(s.segment(chunks_.first_dof(c), chunks_.dofs(c)));
+  }
+  return sum_in_order(partial_rs_);
+}
+
+double ParallelPcg::product(const BlockSparseMatrix& A) {
+  // q = A p reads p of the neighbouring rows: the barrier that ended p's update comes first.
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    A.multiply_rows(p_, q_, chunks_.start[c], chunks_.start[c + 1]);
+    partial_pq_[c] = p_.segment(chunks_.first_dof(c), chunks_.dofs(c))
+                         .dot(q_.segment(chunks_.first_dof(c), chunks_.dofs(c)));
+  }
+  return sum_in_order(partial_pq_);
+}
+
+double ParallelPcg::update(const Preconditioner& M, double step, Eigen::VectorXd& y) {
+  // Every vector operation of the iteration that needs no neighbour, on one chunk at a time
+  // while it sits in L1: y += step p, r -= step q, r filtered, ||r||^2, and for a
+  // block-diagonal M also s = S M r and r . s. Each is an Eigen expression on the chunk's
+  // segment, so it keeps the SIMD of the whole-vector operations of the chapters before.
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
+    y.segment(first, size) += step * p_.segment(first, size);
+    r_.segment(first, size) -= step * q_.segment(first, size);
+    filter(c, r_);
+    if (M.block_diagonal()) precondition_chunk(M, c, s_);
+    partial_rr_[c] = r_.segment(first, size).squaredNorm();
+  }
+  return sum_in_order(partial_rr_);
+}
+
+void ParallelPcg::next_direction(double beta) {
+#pragma omp for schedule(static)
+  for (int c = 0; c < chunks_.count(); ++c) {
+    const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
+    p_.segment(first, size) = s_.segment(first, size) + beta * p_.segment(first, size);
+  }
+}
+
+}  // namespace fem::ch09

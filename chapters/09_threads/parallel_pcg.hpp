@@ -1,0 +1,110 @@
+// Chapter 09's building block: the PCG on every core, deterministically. The rows are cut
+// into a FIXED set of chunks (RowChunks); every parallel loop over rows shares out those
+// chunks, and every sum over the mesh is a sum of per-chunk sums added in chunk order, never
+// an OpenMP reduction (whose order of combination OpenMP leaves unspecified). So the solve
+// gives the same bits for any thread count. The preconditioner is a parameter: block
+// Jacobi here, chapter 10's V-cycle there. Chapter 10 includes this file.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "chapters/07_block_sparse/block_sparse.hpp"
+#include "common/stepper.hpp"
+
+namespace fem::ch09 {
+
+using ch07::BlockSparseMatrix;
+
+// The fixed partition of the node rows that every parallel loop over rows and every sum
+// uses: up to 64 chunks of about the same number of blocks, whatever the thread count.
+// Threads take whole chunks (a static schedule); a sum over the mesh is the sum of per-chunk
+// sums, added in chunk order: the same additions in the same order for any thread count.
+struct RowChunks {
+  static constexpr int kMaxCount = 64, kMinRows = 32;
+  std::vector<int> start;  // chunk c holds rows start[c] .. start[c+1]-1
+
+  RowChunks() = default;
+  explicit RowChunks(const BlockSparseMatrix& pattern);
+  int count() const { return static_cast<int>(start.size()) - 1; }
+  int rows(int c) const { return start[c + 1] - start[c]; }
+  // The scalar entries of chunk c in a vector of 3 dofs per node: first and size.
+  int first_dof(int c) const { return 3 * start[c]; }
+  int dofs(int c) const { return 3 * rows(c); }
+};
+
+// The sum of per-chunk partial sums, in chunk order. Every thread adds them up itself after
+// the barrier (64 additions): the same value on every thread, and no extra barrier to hand a
+// result from one thread to the others.
+double sum_in_order(const std::vector<double>& partial);
+
+// s = M r for the PCG. Every member is called by every thread of the solve's team (inside
+// its parallel region): the work is shared out by orphaned `omp for` or `omp single`
+// constructs, each ending with a barrier.
+class Preconditioner {
+ public:
+  virtual ~Preconditioner() = default;
+  // This solve's numbers from A, before the first apply.
+  virtual void prepare(const BlockSparseMatrix& A, const RowChunks& chunks) = 0;
+  // A block-diagonal M reads only the rows it writes: the PCG applies it chunk by chunk inside
+  // its own loops, with no barrier of its own (apply_rows). Any other M sees the whole
+  // residual, after a barrier (apply).
+  virtual bool block_diagonal() const = 0;
+  virtual void apply_rows(int first, int last, const Eigen::VectorXd& r, Eigen::VectorXd& s) const;
+  virtual void apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s);
+};
+
+// Block Jacobi, s_i = D_i^-1 r_i with D_i the 3x3 diagonal block: chapter 07's, per chunk.
+class BlockJacobi final : public Preconditioner {
+ public:
+  BlockJacobi() = default;
+  explicit BlockJacobi(const std::vector<int>& diagonal_block);
+  void prepare(const BlockSparseMatrix& A, const RowChunks& chunks) override;
+  bool block_diagonal() const override { return true; }
+  void apply_rows(int first, int last, const Eigen::VectorXd& r, Eigen::VectorXd& s) const override;
+
+ private:
+  std::vector<int> diagonal_block_;
+  std::vector<Eigen::Matrix3d> inverse_diagonal_;  // (A_ii)^-1
+};
+
+// Preconditioned CG on the filtered block system, with the same stopping rule and PPCG filter
+// as chapter 06, in one parallel region. Set up once per pattern and set of constraints; the
+// work vectors are sized on the first solve and reused.
+class ParallelPcg {
+ public:
+  ParallelPcg() = default;
+  ParallelPcg(const BlockSparseMatrix& pattern, const std::vector<NodeConstraint>& constraints);
+  // y holds the initial guess on entry and the solution on exit.
+  SolveStats solve(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
+                   const SolverSettings& settings, Eigen::VectorXd& y);
+  const RowChunks& chunks() const { return chunks_; }
+
+ private:
+  // The steps of one solve, each called by every thread and each one `omp for` over the
+  // chunks (so one barrier): they return the sum over the mesh, the same on every thread.
+  SolveStats iterate(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
+                     double rhs_norm2, const SolverSettings& settings, Eigen::VectorXd& y);
+  double filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y);  // S y; ||b||^2
+  double residual(const BlockSparseMatrix& A, const Preconditioner& M, const Eigen::VectorXd& b,
+                  const Eigen::VectorXd& y);              // r = S (b - A y); ||r||^2
+  double precondition(Preconditioner& M, Eigen::VectorXd& s);  // s = S M r; r . s
+  double product(const BlockSparseMatrix& A);                  // q = A p; p . q
+  double update(const Preconditioner& M, double step, Eigen::VectorXd& y);  // y, r; ||r||^2
+  void next_direction(double beta);                                         // p = s + beta p
+  // Chunk c's share of the block-diagonal M: s = S M r on its rows, and its part of r . s.
+  void precondition_chunk(const Preconditioner& M, int c, Eigen::VectorXd& s);
+  // v_i <- S_i v_i on the constrained nodes of chunk c: the PPCG projection.
+  void filter(int c, Eigen::VectorXd& v) const;
+
+  RowChunks chunks_;
+  // The constraints sorted by node: chunk c's are constraints_[constraint_start_[c] ..].
+  std::vector<NodeConstraint> constraints_;
+  std::vector<int> constraint_start_;
+  Eigen::VectorXd r_, s_, p_, q_;
+  // Per-chunk partial sums, one array per reduction, so that no array is written again
+  // while a slower thread may still be adding it up.
+  std::vector<double> partial_bb_, partial_pq_, partial_rr_, partial_rs_;
+};
+
+}  // namespace fem::ch09

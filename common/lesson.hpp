@@ -1,0 +1,74 @@
+// What a lesson's measurement is: the code behind a table of a chapter's README. It lives in
+// its chapter (chapters/NN_name/lesson.cpp, declared in lesson.hpp), the registry lists it
+// with the chapter, and fem_lessons runs it by name, for the chapter or a student's variant
+// of it (a variant's copy of lesson.cpp measures the variant's code).
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/cli.hpp"
+#include "common/scene.hpp"
+
+namespace fem {
+
+// What a lesson's table is computed from.
+struct LessonRun {
+  const ArgParser& args;  // the lesson's own options, parsed
+  const Scene& scene;
+  int steps;            // measured steps or solves (--steps)
+  std::string chapter;  // the chapter (or variant) whose code is measured
+};
+
+struct Lesson {
+  std::string name;          // e.g. "rotations": `fem_lessons rotations`
+  std::string summary;       // one line for --help
+  std::string default_mesh;  // e.g. "meshes/plate_poster.msh"
+  // The lesson's options beyond the scene, --steps, --threads, --readme and --chapter (may be
+  // empty).
+  std::function<void(ArgParser&)> add_options;
+  // The lesson's Markdown table (and the sentence under it that says how it was measured).
+  std::function<std::string(const LessonRun&)> table;
+};
+
+// ---- what the measurements share ----------------------------------------------------------
+
+double median(std::vector<double> v);
+
+// Median wall-clock milliseconds (std::chrono::steady_clock) of f, run `repeat` times but
+// stopped once `budget_s` seconds are spent (after one run at least), so that a lesson on a
+// large mesh finishes in bounded time.
+template <class F>
+double time_ms(int repeat, F&& f, double budget_s = 10.0);
+
+// Progress of a long lesson, on stderr so that stdout stays the Markdown table.
+void progress(const std::string& what);
+
+// `s` as Markdown code, with '|' replaced so that a table cell stays intact.
+std::string code(const std::string& s);
+
+// "plate_poster.msh": the mesh's file name, for the sentence under a table.
+std::string mesh_name(const Scene& scene);
+
+// "AMD EPYC ..., GNU 12.2.0, `-O3 ...`": where and how a table was measured.
+std::string measured_on();
+
+// ---- definitions of the templates -----------------------------------------------------
+
+template <class F>
+double time_ms(int repeat, F&& f, double budget_s) {
+  std::vector<double> ms;
+  double spent = 0.0;
+  for (int k = 0; k < repeat && (k == 0 || spent < budget_s); ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    ms.push_back(1e3 *
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    spent += 1e-3 * ms.back();
+  }
+  return median(ms);
+}
+
+}  // namespace fem
