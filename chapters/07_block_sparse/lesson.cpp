@@ -46,21 +46,20 @@ BlockSparseMatrix upper(const BlockSparseMatrix& A) {
 
 namespace {
 
+// One row of the SpMV table: its median time against Eigen's column-major product.
+std::string spmv_row(const std::string& what, double ms, double reference_ms, double index_kib) {
+  std::ostringstream row;
+  row << std::fixed << "| " << what << " | " << std::setprecision(4) << ms << " | "
+      << std::setprecision(2) << reference_ms / ms << "x | " << std::setprecision(0) << index_kib
+      << " |\n";
+  return row.str();
+}
 
-std::string spmv_table(const Scene& scene, int steps) {
-  ch07::BlockSparseStepper stepper(scene, {});
-  State state = rest_state(scene);
-  // A real, filtered system: a few steps in, the body moving. Each costs a full solve, which
-  // on a large mesh takes seconds, so a few only.
-  constexpr int kSetupSteps = 3;
-  progress(std::to_string(kSetupSteps) + " steps of chapter 07 for a real, filtered system");
-  for (int k = 0; k < kSetupSteps; ++k) stepper.step(state);
-  const ch07::BlockSparseMatrix& A = stepper.system_matrix();
+// y = A x by Eigen's three products and by the blocks, full and symmetric storage.
+std::string spmv_rows(const BlockSparseMatrix& A, const Eigen::SparseMatrix<double>& csc, int repeat) {
   const BlockSparseMatrix upper_A = upper(A);
-  const Eigen::SparseMatrix<double> csc = A.to_sparse();
   const Eigen::VectorXd x = Eigen::VectorXd::Ones(csc.cols());
   Eigen::VectorXd y(x.size());
-  const int repeat = 20 * steps;
   progress("SpMV, five formats, " + std::to_string(repeat) + " runs or 10 s each");
   const double eigen_col = time_ms(repeat, [&] { y.noalias() = csc * x; });
   const double eigen_row = time_ms(repeat, [&] { y.noalias() = csc.transpose() * x; });
@@ -68,20 +67,32 @@ std::string spmv_table(const Scene& scene, int steps) {
       time_ms(repeat, [&] { y.noalias() = csc.selfadjointView<Eigen::Lower>() * x; });
   const double block_full = time_ms(repeat, [&] { A.multiply(x, y); });
   const double block_upper = time_ms(repeat, [&] { multiply_upper(upper_A, x, y); });
-  const long long nnz = csc.nonZeros();
-  const std::size_t nb = A.blocks.size();
   // Index memory: CSC stores one row index per entry and one pointer per column; BSR one
   // column index per block and one pointer per block row.
-  const double csc_index_kb = (nnz + csc.cols() + 1) * sizeof(int) / 1024.0;
-  const double bsr_index_kb = (nb + A.row_start.size()) * sizeof(int) / 1024.0;
+  const auto kib = [](std::size_t ints) { return static_cast<double>(ints * sizeof(int)) / 1024.0; };
+  const double csc_kib = kib(csc.nonZeros() + csc.cols() + 1);
+  return "| SpMV, y = A x | median ms | vs Eigen column-major | index memory (KiB) |\n"
+         "| --- | ---: | ---: | ---: |\n" +
+         spmv_row("Eigen CSC, `A * x` (column scatter)", eigen_col, eigen_col, csc_kib) +
+         spmv_row("Eigen CSC, `A.transpose() * x` (row gather, chapter 06)", eigen_row, eigen_col,
+                  csc_kib) +
+         spmv_row("Eigen CSC, `selfadjointView<Lower>() * x` (what `ConjugateGradient` uses)",
+                  eigen_lower, eigen_col, csc_kib) +
+         spmv_row("3x3 blocks, full storage (chapter 07)", block_full, eigen_col,
+                  kib(A.blocks.size() + A.row_start.size())) +
+         spmv_row("3x3 blocks, symmetric (upper) storage", block_upper, eigen_col,
+                  kib(upper_A.blocks.size() + upper_A.row_start.size()));
+}
 
-  // The PCG on the same system: scalar Jacobi (chapter 06, on the CSC copy) and block
-  // Jacobi (chapter 07).
+// The PCG on the same system from zero: scalar Jacobi (chapter 06, on the CSC copy) and block
+// Jacobi (chapter 07).
+std::string pcg_rows(const BlockSparseStepper& stepper, const Eigen::SparseMatrix<double>& csc,
+                     const Scene& scene, int steps) {
   const Eigen::VectorXd& b = stepper.system_rhs();
   const std::vector<int> offsets = ch06::diagonal_offsets(csc);
-  SolverSettings settings;
+  const SolverSettings settings;
   ch06::PcgWorkspace work6;
-  ch07::PcgWorkspace work7;
+  PcgWorkspace work7;
   Eigen::VectorXd y6, y7;
   SolveStats r6, r7;
   progress("PCG from zero, scalar and block Jacobi, " + std::to_string(steps) +
@@ -92,41 +103,38 @@ std::string spmv_table(const Scene& scene, int steps) {
   });
   const double pcg7 = time_ms(steps, [&] {
     y7.setZero(b.size());
-    r7 = ch07::pcg_solve(A, stepper.diagonal_blocks(), b, scene.constraints, settings, work7, y7);
+    r7 = pcg_solve(stepper.system_matrix(), stepper.diagonal_blocks(), b, scene.constraints,
+                   settings, work7, y7);
   });
-
   std::ostringstream out;
-  out << std::fixed << std::setprecision(4);
-  out << "| SpMV, y = A x | median ms | vs Eigen column-major | index memory (KiB) |\n"
-      << "| --- | ---: | ---: | ---: |\n"
-      << "| Eigen CSC, `A * x` (column scatter) | " << eigen_col << " | 1.00x | "
-      << std::setprecision(0) << csc_index_kb << " |\n"
-      << std::setprecision(4) << "| Eigen CSC, `A.transpose() * x` (row gather, chapter 06) | "
-      << eigen_row << " | " << std::setprecision(2) << eigen_col / eigen_row << "x | "
-      << std::setprecision(0) << csc_index_kb << " |\n"
-      << std::setprecision(4)
-      << "| Eigen CSC, `selfadjointView<Lower>() * x` (what `ConjugateGradient` uses) | "
-      << eigen_lower << " | " << std::setprecision(2) << eigen_col / eigen_lower << "x | "
-      << std::setprecision(0) << csc_index_kb << " |\n"
-      << std::setprecision(4) << "| 3x3 blocks, full storage (chapter 07) | " << block_full << " | "
-      << std::setprecision(2) << eigen_col / block_full << "x | " << std::setprecision(0)
-      << bsr_index_kb << " |\n"
-      << std::setprecision(4) << "| 3x3 blocks, symmetric (upper) storage | " << block_upper
-      << " | " << std::setprecision(2) << eigen_col / block_upper << "x | " << std::setprecision(0)
-      << (upper_A.blocks.size() + upper_A.row_start.size()) * sizeof(int) / 1024.0 << " |\n\n";
-  out << "| PCG from zero, same system and tolerance | median ms | iterations |\n"
+  out << std::fixed << std::setprecision(3)
+      << "| PCG from zero, same system and tolerance | median ms | iterations |\n"
       << "| --- | ---: | ---: |\n"
-      << std::setprecision(3) << "| scalar Jacobi on CSC (chapter 06) | " << pcg6 << " | "
-      << r6.iterations << " |\n"
+      << "| scalar Jacobi on CSC (chapter 06) | " << pcg6 << " | " << r6.iterations << " |\n"
       << "| block Jacobi on 3x3 blocks (chapter 07) | " << pcg7 << " | " << r7.iterations
-      << " |\n\n";
-  out << "The filtered system of step " << kSetupSteps << " of the " << scene.name << " scene on "
-      << mesh_name(scene) << " ("
-      << scene.mesh.num_nodes() << " nodes, " << nnz << " non-zeros, " << nb << " blocks); "
-      << measured_on() << ". Generated by `fem_lessons spmv`.\n";
+      << " |\n";
   return out.str();
 }
 
+std::string spmv_table(const Scene& scene, int steps) {
+  BlockSparseStepper stepper(scene, {});
+  State state = rest_state(scene);
+  // A real, filtered system: a few steps in, the body moving. Each costs a full solve, which
+  // on a large mesh takes seconds, so a few only.
+  constexpr int kSetupSteps = 3;
+  progress(std::to_string(kSetupSteps) + " steps of chapter 07 for a real, filtered system");
+  for (int k = 0; k < kSetupSteps; ++k) stepper.step(state);
+  const BlockSparseMatrix& A = stepper.system_matrix();
+  const Eigen::SparseMatrix<double> csc = A.to_sparse();
+  std::ostringstream out;
+  out << spmv_rows(A, csc, 20 * steps) << "\n"
+      << pcg_rows(stepper, csc, scene, steps) << "\n"
+      << "The filtered system of step " << kSetupSteps << " of the " << scene.name << " scene on "
+      << mesh_name(scene) << " (" << scene.mesh.num_nodes() << " nodes, " << csc.nonZeros()
+      << " non-zeros, " << A.blocks.size() << " blocks); " << measured_on()
+      << ". Generated by `fem_lessons spmv`.\n";
+  return out.str();
+}
 
 }  // namespace
 

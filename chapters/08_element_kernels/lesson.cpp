@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
-#include <iostream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -27,144 +26,168 @@ Eigen::Matrix3d polar_by_eigensolver(const Eigen::Matrix3d& F) {
   return F * V * eigen.eigenvalues().cwiseSqrt().cwiseInverse().asDiagonal() * V.transpose();
 }
 
-std::string rotations_table(const Scene& bench_scene, int steps) {
-  // Deformation gradients of a real step, and the rotations of the step before: the warm
-  // start the stepper has.
-  ch08::ElementKernelsStepper stepper(bench_scene, {});
-  State state = rest_state(bench_scene);
-  for (int k = 0; k < 20; ++k) stepper.step(state);
-  const Model model(bench_scene);
-  const std::size_t m = model.tets.size();
-  std::vector<Eigen::Matrix3d> F(m), R(m);
-  for (std::size_t e = 0; e < m; ++e)
-    F[e] = deformation_gradient(model.rest[e], gather(state.x, model.tets[e]));
-  const std::vector<Eigen::Quaterniond> previous = stepper.elements().rotations();
-  const std::vector<Eigen::Quaterniond> before = stepper.elements().previous_rotations();
-  std::vector<Eigen::Quaterniond> q(m);
+// What the rows measure: the deformation gradients of step 21 of a real run, and the warm
+// starts the stepper has for it (the rotations of the two steps before).
+struct ElementSample {
+  Model model;
+  std::vector<Eigen::Matrix3d> F;
+  std::vector<Eigen::Quaterniond> previous, before;
+  std::vector<ElementShape> shapes;
+  std::size_t size() const { return F.size(); }
+};
 
-  const int repeat = std::max(5, steps);
+ElementSample sample_step(const Scene& scene) {
+  ElementKernelsStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 20; ++k) stepper.step(state);
+  ElementSample sample{Model(scene), {}, stepper.elements().rotations(),
+                       stepper.elements().previous_rotations(), stepper.elements().shapes()};
+  for (std::size_t e = 0; e < sample.model.tets.size(); ++e)
+    sample.F.push_back(deformation_gradient(sample.model.rest[e], gather(state.x, sample.model.tets[e])));
+  return sample;
+}
+
+// Newton's iterations summed over the elements, and the elements where it cannot decide.
+struct NewtonCount {
+  long long iterations = 0, undecided = 0;
+  void add(int k) { k > 0 ? iterations += k : ++undecided; }
+  std::string mean(std::size_t elements) const {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(2)
+      << static_cast<double>(iterations) / static_cast<double>(elements - undecided);
+    if (undecided > 0) s << " (" << undecided << " undecided)";
+    return s.str();
+  }
+};
+
+std::string table_row(const std::string& what, double ns, double reference_ns, const std::string& last) {
+  std::ostringstream row;
+  row << std::fixed << "| " << what << " | " << std::setprecision(1) << ns << " | "
+      << std::setprecision(2) << reference_ns / ns << "x | " << last << " |\n";
+  return row.str();
+}
+
+// Newton from a start (q = start(e)), counted, as ns per element.
+template <class Start>
+double newton_ns(const ElementSample& sample, int repeat, Start&& start, NewtonCount& count) {
+  std::vector<Eigen::Quaterniond> q(sample.size());
+  return 1e6 / static_cast<double>(sample.size()) * time_ms(repeat, [&] {
+           count = NewtonCount{};
+           for (std::size_t e = 0; e < sample.size(); ++e) {
+             q[e] = start(e);
+             count.add(newton_polar_rotation(sample.F[e], q[e]));
+           }
+         });
+}
+
+// The rotation rows; R gets the stepper's rotations, difference their largest from common/'s.
+std::string rotation_rows(const ElementSample& s, int repeat, std::vector<Eigen::Matrix3d>& R,
+                          double& difference) {
+  const std::size_t m = s.size();
   const double to_ns = 1e6 / static_cast<double>(m);  // median ms of a sweep -> ns/element
-  long long fallbacks = 0;
-  // Newton's iterations summed over the elements, and the elements where it cannot decide.
-  struct Count {
-    long long iterations = 0, undecided = 0;
-    void add(int k) { k > 0 ? iterations += k : ++undecided; }
-    std::string mean(std::size_t elements) const {
-      std::ostringstream s;
-      s << std::fixed << std::setprecision(2)
-        << static_cast<double>(iterations) / static_cast<double>(elements - undecided);
-      if (undecided > 0) s << " (" << undecided << " undecided)";
-      return s.str();
-    }
-  } count_cold, count_warm, count_predicted;
+  R.resize(m);
   const double svd = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(F[e]);
+    for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(s.F[e]);
   });
   const double eigensolver = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) R[e] = polar_by_eigensolver(F[e]);
+    for (std::size_t e = 0; e < m; ++e) R[e] = polar_by_eigensolver(s.F[e]);
   });
-  const double cold = to_ns * time_ms(repeat, [&] {
-    count_cold = Count{};
-    for (std::size_t e = 0; e < m; ++e) {
-      q[e] = Eigen::Quaterniond::Identity();
-      count_cold.add(ch08::newton_polar_rotation(F[e], q[e]));
-    }
-  });
-  const double warm = to_ns * time_ms(repeat, [&] {
-    count_warm = Count{};
-    for (std::size_t e = 0; e < m; ++e) {
-      q[e] = previous[e];
-      count_warm.add(ch08::newton_polar_rotation(F[e], q[e]));
-    }
-  });
-  const double predicted = to_ns * time_ms(repeat, [&] {
-    count_predicted = Count{};
-    for (std::size_t e = 0; e < m; ++e) {
-      q[e] = ch08::predicted_rotation(previous[e], before[e]);
-      count_predicted.add(ch08::newton_polar_rotation(F[e], q[e]));
-    }
-  });
+  NewtonCount cold, warm, predicted;
+  const auto identity = [](std::size_t) { return Eigen::Quaterniond::Identity(); };
+  const auto last = [&](std::size_t e) { return s.previous[e]; };
+  const auto extrapolated = [&](std::size_t e) { return predicted_rotation(s.previous[e], s.before[e]); };
+  const double cold_ns = newton_ns(s, repeat, identity, cold);
+  const double warm_ns = newton_ns(s, repeat, last, warm);
+  const double predicted_ns = newton_ns(s, repeat, extrapolated, predicted);
+  long long fallbacks = 0;
   const double fast = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) {
-      q[e] = ch08::predicted_rotation(previous[e], before[e]);
-      R[e] = ch08::fast_polar_rotation(F[e], q[e], fallbacks);
+      Eigen::Quaterniond q = extrapolated(e);
+      R[e] = fast_polar_rotation(s.F[e], q, fallbacks);
     }
   });
-  double difference = 0.0;  // the answers, against common/'s
+  difference = 0.0;  // the answers, against common/'s
   for (std::size_t e = 0; e < m; ++e)
-    difference = std::max(difference, (R[e] - polar_rotation(F[e])).cwiseAbs().maxCoeff());
+    difference = std::max(difference, (R[e] - polar_rotation(s.F[e])).cwiseAbs().maxCoeff());
+  return "| rotation of one element | ns per element | vs JacobiSVD | iterations |\n"
+         "| --- | ---: | ---: | ---: |\n" +
+         table_row("`JacobiSVD<Matrix3d>`, U V^T (common/, chapters 01-07)", svd, svd, "-") +
+         table_row("`SelfAdjointEigenSolver::computeDirect` of F^T F (no inversion, squared "
+                   "condition)", eigensolver, svd, "-") +
+         table_row("Newton, cold (from the identity)", cold_ns, svd, cold.mean(m)) +
+         table_row("Newton, warm (from the previous step's rotation)", warm_ns, svd, warm.mean(m)) +
+         table_row("Newton, warm (predicted from the last two steps' rotations)", predicted_ns, svd,
+                   predicted.mean(m)) +
+         table_row("predicted start, Newton, SVD fallback: the stepper's (chapter 08)", fast, svd, "-");
+}
 
-  // The element blocks: sixteen -R K0_ab R^T from the stored K0 (chapter 07), against the
-  // ten distinct blocks in closed form from the shape gradients (chapter 08).
-  std::vector<ch08::ElementShape> shapes = stepper.elements().shapes();
+// The element blocks: sixteen -R K0_ab R^T from the stored K0 (chapter 07), against the ten
+// distinct blocks in closed form from the shape gradients (chapter 08).
+std::string block_rows(const ElementSample& s, const std::vector<Eigen::Matrix3d>& R, int repeat) {
+  const std::size_t m = s.size();
+  const double to_ns = 1e6 / static_cast<double>(m);
   Eigen::Matrix3d sink = Eigen::Matrix3d::Zero();  // keeps the blocks from being optimized out
   const double stored = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e)
-      for (int ab = 0; ab < 16; ++ab) sink += dfdx_block(model.rest[e], R[e], ab / 4, ab % 4);
+      for (int ab = 0; ab < 16; ++ab) sink += dfdx_block(s.model.rest[e], R[e], ab / 4, ab % 4);
   });
   std::array<Eigen::Matrix3d, 10> K;
   const double closed = to_ns * time_ms(repeat, [&] {
     for (std::size_t e = 0; e < m; ++e) {
-      ch08::stiffness_blocks(ch08::rotated_gradients(R[e], shapes[e].Dm_inv), shapes[e].mu_volume,
-                             shapes[e].lambda_volume, K);
+      stiffness_blocks(rotated_gradients(R[e], s.shapes[e].Dm_inv), s.shapes[e].mu_volume,
+                       s.shapes[e].lambda_volume, K);
       for (const Eigen::Matrix3d& k : K) sink += k;
     }
   });
+  volatile double keep = sink.sum();
+  (void)keep;
+  const auto rest_data = [m](std::size_t bytes) {
+    std::ostringstream cell;
+    cell << std::fixed << bytes << " | " << std::setprecision(2)
+         << static_cast<double>(bytes * m) / (1 << 20);
+    return cell.str();
+  };
+  return "| element blocks of -df/dx | ns per element | vs stored K0 | rest data per element "
+         "(bytes) | rest data per step (MiB) |\n| --- | ---: | ---: | ---: | ---: |\n" +
+         table_row("sixteen `-R K0_ab R^T` from the stored K0 (chapter 07)", stored, stored,
+                   rest_data(sizeof(ElementRest))) +
+         table_row("ten closed-form blocks from the shape gradients (chapter 08)", closed, stored,
+                   rest_data(sizeof(ElementShape)));
+}
 
-  // How often the stepper falls back to the SVD on the benchmark's scenes.
+// How often the stepper falls back to the SVD on the benchmark's scenes.
+std::string fallback_counts(const Scene& bench_scene, int steps) {
   std::ostringstream scenes;
   for (const std::string& name : scene_names()) {
-    std::cerr << "fem_lessons rotations: " << steps << " steps of the " << name
-              << " scene, counting SVD fallbacks\n";
+    progress(std::to_string(steps) + " steps of the " + name + " scene, counting SVD fallbacks");
     Scene scene = make_scene(name, bench_scene.mesh, bench_scene.material);
     scene.dt = bench_scene.dt;
-    ch08::ElementKernelsStepper run(scene, {});
+    ElementKernelsStepper run(scene, {});
     State s = rest_state(scene);
     for (int k = 0; k < steps; ++k) run.step(s);
-    scenes << (scenes.tellp() > 0 ? ", " : "") << name << " " << run.elements().total_fallbacks() << " of "
-           << static_cast<long long>(steps) * static_cast<long long>(m);
+    scenes << (scenes.tellp() > 0 ? ", " : "") << name << " " << run.elements().total_fallbacks()
+           << " of " << static_cast<long long>(steps) * bench_scene.mesh.num_tets();
   }
+  return scenes.str();
+}
 
-  const auto mib = [m](std::size_t bytes) { return static_cast<double>(bytes * m) / (1 << 20); };
+std::string rotations_table(const Scene& bench_scene, int steps) {
+  const ElementSample sample = sample_step(bench_scene);
+  const int repeat = std::max(5, steps);
+  std::vector<Eigen::Matrix3d> R;
+  double difference = 0.0;
   std::ostringstream out;
-  out << std::fixed << std::setprecision(1);
-  out << "| rotation of one element | ns per element | vs JacobiSVD | iterations |\n"
-      << "| --- | ---: | ---: | ---: |\n"
-      << "| `JacobiSVD<Matrix3d>`, U V^T (common/, chapters 01-07) | " << svd << " | 1.00x | - |\n"
-      << "| `SelfAdjointEigenSolver::computeDirect` of F^T F (no inversion, squared condition) | "
-      << eigensolver << " | " << std::setprecision(2) << svd / eigensolver << "x | - |\n"
-      << std::setprecision(1) << "| Newton, cold (from the identity) | " << cold << " | "
-      << std::setprecision(2) << svd / cold << "x | " << count_cold.mean(m) << " |\n"
-      << std::setprecision(1) << "| Newton, warm (from the previous step's rotation) | " << warm
-      << " | " << std::setprecision(2) << svd / warm << "x | " << count_warm.mean(m) << " |\n"
-      << std::setprecision(1)
-      << "| Newton, warm (predicted from the last two steps' rotations) | " << predicted
-      << " | " << std::setprecision(2) << svd / predicted << "x | " << count_predicted.mean(m)
-      << " |\n"
-      << std::setprecision(1)
-      << "| predicted start, Newton, SVD fallback: the stepper's (chapter 08) | " << fast
-      << " | " << std::setprecision(2) << svd / fast << "x | - |\n\n";
-  out << std::setprecision(1)
-      << "| element blocks of -df/dx | ns per element | vs stored K0 | rest data per element "
-         "(bytes) | rest data per step (MiB) |\n"
-      << "| --- | ---: | ---: | ---: | ---: |\n"
-      << "| sixteen `-R K0_ab R^T` from the stored K0 (chapter 07) | " << stored << " | 1.00x | "
-      << sizeof(ElementRest) << " | " << std::setprecision(2) << mib(sizeof(ElementRest)) << " |\n"
-      << std::setprecision(1) << "| ten closed-form blocks from the shape gradients (chapter 08) | "
-      << closed << " | " << std::setprecision(2) << stored / closed << "x | "
-      << sizeof(ch08::ElementShape) << " | " << mib(sizeof(ch08::ElementShape)) << " |\n\n";
-  out << std::setprecision(1) << "Step 21 of the " << bench_scene.name << " scene on "
-      << mesh_name(bench_scene) << " ("
+  out << rotation_rows(sample, repeat, R, difference) << "\n"
+      << block_rows(sample, R, repeat) << "\n"
+      << "Step 21 of the " << bench_scene.name << " scene on " << mesh_name(bench_scene) << " ("
       << bench_scene.mesh.num_tets() << " tets); median of " << repeat
       << " sweeps over all elements. Largest difference from common/'s rotation: "
       << std::scientific << std::setprecision(1) << difference << std::fixed
-      << ". SVD fallbacks of the stepper over " << steps << " steps (elements x steps): "
-      << scenes.str() << ". " << measured_on() << ". Generated by `fem_lessons rotations`.\n";
-  volatile double keep = sink.sum();
-  (void)keep;
+      << ". SVD fallbacks of the stepper over " << steps
+      << " steps (elements x steps): " << fallback_counts(bench_scene, steps) << ". "
+      << measured_on() << ". Generated by `fem_lessons rotations`.\n";
   return out.str();
 }
-
 
 }  // namespace
 
