@@ -24,7 +24,6 @@ class BlockSparseStepper final : public Stepper {
   // The last step's filtered system S A S^T + I - S and right-hand side S (b - A z).
   const BlockSparseMatrix& system_matrix() const { return A_; }
   const Eigen::VectorXd& system_rhs() const { return filtered_b_; }
-  const BlockSparseMatrix& dfdx() const { return dfdx_; }
   const std::vector<int>& diagonal_blocks() const { return index_.diagonal; }
 
  private:

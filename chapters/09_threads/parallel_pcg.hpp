@@ -78,7 +78,6 @@ class ParallelPcg {
   // y holds the initial guess on entry and the solution on exit.
   SolveStats solve(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
                    const SolverSettings& settings, Eigen::VectorXd& y);
-  const RowChunks& chunks() const { return chunks_; }
 
  private:
   // The steps of one solve, each called by every thread and each one `omp for` over the
