@@ -55,6 +55,9 @@ commands:
              tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
+  lessons    measure the lesson tables (fem_lessons, scripts/pyamg_reference.py; a few minutes),
+             record them in docs/data/lessons/*.json and write them into the chapter READMEs
+             (ctest -L docs checks that the READMEs hold the recorded tables); part of docs
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   viewer-bench
@@ -213,20 +216,24 @@ regimes() {
   "$VENV/bin/python" scripts/regimes.py --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
 }
 
+lessons() {
+  quiet_build
+  log "lesson tables (fem_lessons, scripts/pyamg_reference.py: a few minutes), recorded in docs/data/lessons/"
+  mkdir -p docs/data/lessons
+  local lesson
+  for lesson in noalias dfdx-fill compose spmv rotations threads-element; do
+    "$BUILD_DIR/fem_lessons" "$lesson" --json "docs/data/lessons/$lesson.json" >/dev/null
+  done
+  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --json docs/data/lessons/multigrid.json >/dev/null
+  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
+    --json docs/data/lessons/pyamg.json >/dev/null
+  "$VENV/bin/python" scripts/lesson_tables.py
+}
+
 docs() {
   quiet_build
   [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
-  log "lesson tables (fem_lessons)"
-  "$BUILD_DIR/fem_lessons" noalias --readme chapters/02_noalias/README.md >/dev/null
-  "$BUILD_DIR/fem_lessons" dfdx-fill --readme chapters/03_indexed_access/README.md >/dev/null
-  "$BUILD_DIR/fem_lessons" compose --readme chapters/04_system_composition/README.md >/dev/null
-  "$BUILD_DIR/fem_lessons" spmv --readme chapters/07_block_sparse/README.md >/dev/null
-  "$BUILD_DIR/fem_lessons" rotations --readme chapters/08_element_kernels/README.md >/dev/null
-  "$BUILD_DIR/fem_lessons" threads-element --readme chapters/09_threads/README.md >/dev/null
-  log "multigrid tables (fem_lessons multigrid, scripts/pyamg_reference.py: about half a minute)"
-  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --readme chapters/10_multigrid/README.md >/dev/null
-  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
-    --readme chapters/10_multigrid/README.md >/dev/null
+  lessons
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
   for json in bench scaling viewer regimes threads; do
@@ -294,6 +301,7 @@ main() {
     regimes) regimes "$@" ;;
     threads) threads "$@" ;;
     docs) docs ;;
+    lessons) lessons ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;
     viewer-bench) viewer_bench "$@" ;;

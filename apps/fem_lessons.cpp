@@ -4,12 +4,15 @@
 // (chapters/NN_name/lesson.cpp); this program finds it through the chapter registry, and
 // with --chapter runs a student's variant's copy beside the original's.
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
+#include "common/json.hpp"
 #include "common/lesson.hpp"
 #include "common/threads.hpp"
 
@@ -47,6 +50,34 @@ Lesson lesson_of(const ChapterInfo& chapter, const std::string& name) {
   throw UsageError("chapter " + chapter.id + " has no lesson '" + name + "'");
 }
 
+// The command line that made a table, for the JSON record.
+std::string command_line(int argc, char** argv) {
+  std::string out = "fem_lessons";
+  for (int i = 0; i < argc; ++i) out += std::string(" ") + argv[i];
+  return out;
+}
+
+// The table as committed data (docs/data/lessons/NAME.json): scripts/lesson_tables.py writes
+// it between the lesson's markers of the chapter's README, and checks that it is there.
+void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo& chapter,
+                const std::string& command, const std::string& table) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
+      << ",\n  \"chapter\": " << json_string(chapter.id) << ",\n  \"readme\": "
+      << json_string("chapters/" + chapter.id + "/README.md") << ",\n  \"marker\": "
+      << json_string(lesson.name + "-table") << ",\n  \"command\": " << json_string(command)
+      << ",\n  \"table\": " << json_string(table) << "\n}\n";
+}
+
+// Fails before the work when the JSON cannot be written there.
+void check_writable(const std::string& path) {
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir))
+    throw UsageError("--json " + path + ": no directory " + dir.string());
+  if (!std::ofstream(path, std::ios::app)) throw UsageError("--json " + path + ": cannot write there");
+}
+
 // Runs one lesson; argv[0] is its name. A variant's table is printed after the original's.
 int run_lesson(const Found& found, int argc, char** argv) {
   const std::string program = "fem_lessons " + found.lesson.name;
@@ -55,6 +86,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
   args.option("steps", "N", "measured steps or solves", "50");
   args.option("chapter", "ID", "also run the lesson's copy in this variant of the chapter", "");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
+  args.option("json", "FILE", "also write the table as JSON (docs/data/lessons/NAME.json)", "");
   add_thread_option(args);
   if (found.lesson.add_options) found.lesson.add_options(args);
   return run_program(program, [&] {
@@ -69,8 +101,10 @@ int run_lesson(const Found& found, int argc, char** argv) {
       if (variant.id != found.chapter->id) runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
     }
     const std::string& readme = args.get("readme");
-    if (!readme.empty() && runs.size() > 1)
-      throw UsageError("--readme writes the course's table: leave --chapter out");
+    const std::string& json = args.get("json");
+    if ((!readme.empty() || !json.empty()) && runs.size() > 1)
+      throw UsageError("--readme and --json record the course's table: leave --chapter out");
+    if (!json.empty()) check_writable(json);
     for (const auto& [chapter, lesson] : runs) {
       if (runs.size() > 1) std::cout << "\n### " << chapter->id << "\n\n";
       const std::string table = lesson.table({args, scene, steps, chapter->id});
@@ -78,6 +112,10 @@ int run_lesson(const Found& found, int argc, char** argv) {
       if (!readme.empty()) {
         write_between_markers(readme, lesson.name + "-table", table);
         std::cout << "wrote " << readme << "\n";
+      }
+      if (!json.empty()) {
+        write_json(json, lesson, *chapter, command_line(argc, argv), table);
+        std::cout << "wrote " << json << "\n";
       }
     }
     return 0;

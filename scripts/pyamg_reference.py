@@ -11,8 +11,9 @@ a Markdown table of the iteration counts beside chapter 10's and the block-Jacob
 on the same system, also from a zero guess.
 
     .venv/bin/python scripts/pyamg_reference.py --tool build/release/fem_lessons
-    .venv/bin/python scripts/pyamg_reference.py --readme chapters/10_multigrid/README.md
-(the second also writes the table between the README's pyamg-table markers)
+    .venv/bin/python scripts/pyamg_reference.py --json docs/data/lessons/pyamg.json
+(the second also records the table, which scripts/lesson_tables.py writes into chapter 10's
+README between its pyamg-table markers)
 """
 import argparse
 import json
@@ -64,6 +65,8 @@ def main():
     parser.add_argument("--tol", type=float, default=1e-4)
     parser.add_argument("--modes", type=int, choices=(3, 6), default=6)
     parser.add_argument("--readme", help="also write the table between the pyamg-table markers")
+    parser.add_argument("--json", help="also write the table as docs/data/lessons/pyamg.json "
+                                       "(scripts/lesson_tables.py puts it into the README)")
     args = parser.parse_args()
     if args.steps <= 0 or not 0 < args.tol < 1:
         parser.error("--steps must be positive and --tol in (0, 1)")
@@ -100,6 +103,12 @@ def main():
     if args.readme:
         write_between_markers(pathlib.Path(args.readme), "pyamg-table", table)
         print(f"wrote {args.readme}")
+    if args.json:
+        record = {"schema_version": 1, "lesson": "pyamg", "chapter": "10_multigrid",
+                  "readme": "chapters/10_multigrid/README.md", "marker": "pyamg-table",
+                  "command": "scripts/pyamg_reference.py " + " ".join(sys.argv[1:]), "table": table}
+        pathlib.Path(args.json).write_text(json.dumps(record, indent=2) + "\n")
+        print(f"wrote {args.json}")
 
 
 def write_between_markers(path, name, text):
