@@ -75,16 +75,20 @@ USAGE
 
 log() { printf '\033[1m==> %s\033[0m\n' "$*"; }
 
+# The Debian packages among the arguments (default: all of APT_PACKAGES) that are missing.
 missing_packages() {
   local p
-  for p in "${APT_PACKAGES[@]}"; do
+  [ $# -gt 0 ] || set -- "${APT_PACKAGES[@]}"
+  for p in "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || echo "$p"
   done
 }
 
+# Installs the missing ones of the arguments (default: all of APT_PACKAGES).
 install_system_packages() {
   local missing
-  missing=$(missing_packages | tr '\n' ' ')
+  command -v dpkg-query >/dev/null || return 0  # not Debian: the user installs them (README)
+  missing=$(missing_packages "$@" | tr '\n' ' ')
   [ -z "${missing// /}" ] && return 0
   if [ "$(id -u)" -eq 0 ]; then
     log "installing Debian packages: $missing"
@@ -120,6 +124,12 @@ configure() {
   fi
 }
 
+# What the Python scripts need (plots, variants, meshes): python3 and its venv, and .venv.
+setup_python() {
+  install_system_packages python3 python3-venv
+  setup_venv
+}
+
 setup() {
   install_system_packages
   setup_venv
@@ -132,13 +142,35 @@ build() {
   cmake --build --preset "$PRESET"
 }
 
-# The build with its log kept out of the way of the results that follow: a summary line, the
+# Ninja's progress from the build's output, "[n/N] what": on a terminal one line rewritten in
+# place, otherwise a line at every tenth of the build, so that a first build (minutes) is never
+# silent. Every line goes on to the log.
+build_progress() {
+  local build_log="$1" tty=0 line count total last=-1
+  [ -t 1 ] && tty=1
+  while IFS= read -r line; do
+    printf '%s\n' "$line" >>"$build_log"
+    [[ "$line" =~ ^\[([0-9]+)/([0-9]+)\] ]] || continue
+    count=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]}
+    if [ "$tty" -eq 1 ]; then
+      printf '\r\033[K  [%s/%s] %.100s' "$count" "$total" "${line#*] }"
+    elif [ $((count * 10 / total)) -ne "$last" ] || [ "$count" -eq "$total" ]; then
+      last=$((count * 10 / total))
+      printf '  [%s/%s] %s\n' "$count" "$total" "${line#*] }"
+    fi
+  done
+  [ "$tty" -eq 1 ] && printf '\r\033[K'
+  return 0
+}
+
+# The build with its log kept out of the way of the results that follow: ninja's progress, the
 # log's tail on failure, and the warnings (if any) named.
 quiet_build() {
   setup
   local build_log="$BUILD_DIR/build.log"
   log "building (preset $PRESET; log in ${build_log#"$ROOT"/})"
-  if ! cmake --build --preset "$PRESET" >"$build_log" 2>&1; then
+  : >"$build_log"
+  if ! cmake --build --preset "$PRESET" 2>&1 | build_progress "$build_log"; then
     tail -n 40 "$build_log" >&2
     echo "the build failed: the whole log is $build_log" >&2
     exit 1
@@ -166,6 +198,12 @@ bench() {
   done
   [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; }
   [ -n "$json" ] || json="$out/bench.json"
+  # The run's folder before the build and the run (fem_bench checks its other arguments before
+  # its work, too): a place that cannot be written fails now, not minutes later.
+  if ! mkdir -p "$out" 2>/dev/null || [ ! -w "$out" ]; then
+    echo "tutorial.sh bench: cannot write the run's folder '$out'" >&2
+    exit 2
+  fi
   quiet_build
   log "benchmarking: fem_bench $* (the run's folder: $out/)"
   "$BUILD_DIR/fem_bench" "$@"
@@ -177,13 +215,15 @@ plots() {
   local json="${1:-results}" out="${2:-}"
   [ -d "$json" ] && { out="${out:-$json}"; json="$json/bench.json"; }
   out="${out:-$(dirname "$json")}"
+  [ -f "$json" ] || { echo "tutorial.sh plots: no $json (usage: ./tutorial.sh plots DIR)" >&2; exit 2; }
+  setup_python
   log "plotting $json into $out/"
   "$VENV/bin/python" scripts/plot_results.py "$json" --out "$out"
 }
 
 variant() {
   [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
-  setup_venv
+  setup_python
   "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
@@ -282,7 +322,7 @@ viewer_bench() {
 }
 
 meshes() {
-  setup_venv
+  setup_python
   "$VENV/bin/python" meshes/generate.py "$@"
 }
 

@@ -25,6 +25,7 @@
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
+#include "common/machine_load.hpp"
 #include "common/threads.hpp"
 
 namespace {
@@ -192,7 +193,10 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   configure(cg_full);
   configure(cg_ichol);
   std::vector<int> offsets;
+  const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
+    if (k > 0 && k % report_every == 0)
+      std::cout << "  solve table: system " << k << "/" << warmup + steps << "\n" << std::flush;
     stepper.step(state);
     const SparseMatrix& A = stepper.system_matrix();
     const Eigen::VectorXd& b = stepper.system_rhs();
@@ -269,9 +273,11 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
 }
 
 // The threaded rows of the solve table, on chapter 09's systems (the same filtered systems
-// as chapter 06's, assembled in another order): stock Eigen's one threaded configuration,
+// as chapter 06's, assembled in another order): stock Eigen's threaded CG,
 // ConjugateGradient<RowMajor, Lower|Upper> with Eigen::setNbThreads(n) (its SpMV is an
-// OpenMP loop over rows, Eigen/src/SparseCore/SparseDenseProduct.h), against chapter 09's
+// OpenMP loop over rows, sparse_time_dense_product_impl in
+// Eigen/src/SparseCore/SparseDenseProduct.h; a column-major matrix with Lower|Upper reaches
+// the same loop through its transpose, TransposeInput in ConjugateGradient.h), against chapter 09's
 // solver with n OpenMP threads. Both start from the previous system's solution.
 std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverSettings& settings,
                                                const std::vector<int>& thread_counts, int warmup,
@@ -295,7 +301,11 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
   cg.setTolerance(settings.tolerance);
   cg.setMaxIterations(settings.max_iterations);
   Eigen::VectorXd previous = Eigen::VectorXd::Zero(state.x.size()), x, next;
+  const int report_every = std::max(1, (warmup + steps) / 5);
   for (int k = 0; k < warmup + steps; ++k) {
+    if (k > 0 && k % report_every == 0)
+      std::cout << "  solve table, threaded rows: system " << k << "/" << warmup + steps << "\n"
+                << std::flush;
     stepper.step(state);
     const RowMajorMatrix A = stepper.system_matrix().to_sparse();  // not timed
     const Eigen::VectorXd& b = stepper.system_rhs();
@@ -358,27 +368,6 @@ void print_solvers(const std::vector<SolverResult>& solvers) {
                  "another order, on N threads)\n";
 }
 
-// The 1-minute load average (/proc/loadavg), -1 where unknown: threads that wait at barriers
-// suffer from every other program on the machine, so the results record how busy it was.
-double load_average() {
-  std::ifstream in("/proc/loadavg");
-  double load = -1.0;
-  return (in >> load) ? load : -1.0;
-}
-
-std::string git_commit() {
-  const std::string cmd =
-      "git -C '" + source_dir() + "' describe --always --dirty --abbrev=7 2>/dev/null";
-  std::string out;
-  if (FILE* pipe = popen(cmd.c_str(), "r")) {
-    char buf[64];
-    while (fgets(buf, sizeof buf, pipe)) out += buf;
-    pclose(pipe);
-  }
-  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-  return out.empty() ? "unknown" : out;
-}
-
 std::string spread_json(const std::array<Spread, 6>& ms, double Spread::*field) {
   std::ostringstream out;
   out << "{";
@@ -399,9 +388,9 @@ std::string allocations_json(const std::array<long long, 6>& a) {
 
 void write_json(const std::string& path, const Scene& scene, const SolverSettings& solver,
                 int warmup, int steps, const std::vector<ChapterResult>& results,
-                const std::vector<SolverResult>& solvers, double load_before) {
+                const std::vector<SolverResult>& solvers, const LoadMonitor& load,
+                const SourceState& source) {
   namespace fs = std::filesystem;
-  if (const fs::path dir = fs::path(path).parent_path(); !dir.empty()) fs::create_directories(dir);
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   const BuildInfo b = build_info();
@@ -423,10 +412,9 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
       << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
-      << ", \"threads\": " << hardware_threads() << ", \"load_average\": [" << load_before
-      << ", " << load_average() << "]},\n";
+      << ", \"threads\": " << hardware_threads() << ", " << load.json_fields() << "},\n";
   out << "  \"openmp\": " << (openmp_enabled() ? "true" : "false") << ",\n";
-  out << "  \"commit\": " << json_string(git_commit()) << ",\n";
+  out << "  " << source_state_json(source) << ",\n";
   out << "  \"chapters\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const ChapterResult& r = results[i];
@@ -519,8 +507,12 @@ std::vector<int> parse_thread_counts(const std::string& list) {
     if (used == 0 || used != item.size() || n < 1)
       throw UsageError("--threads expects thread counts >= 1 separated by commas, got '" + list +
                        "'");
-    if (n > 1 && !openmp_enabled())
-      throw UsageError("--threads " + item + ": this build has no OpenMP (FEM_OPENMP=OFF)");
+    try {
+      if (const std::string warning = check_thread_count(n); !warning.empty())
+        std::cerr << "fem_bench: warning: --threads " << item << ": " << warning << "\n";
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--threads " + item + ": " + e.what());
+    }
     if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
   }
   return out;
@@ -545,11 +537,49 @@ std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
   return out;
 }
 
-// --json FILE, else DIR/bench.json of --out DIR; "" when both are empty.
+// --json FILE, else DIR/bench.json of --out DIR; "" with --no-json or when both are empty.
 std::string json_path(const ArgParser& args) {
+  if (args.has_flag("no-json")) {
+    if (args.has_flag("json") && !args.get("json").empty())
+      throw UsageError("--no-json and --json " + args.get("json") + " contradict each other");
+    return "";
+  }
   if (!args.get("json").empty()) return args.get("json");
   if (args.get("out").empty()) return "";
   return (std::filesystem::path(args.get("out")) / "bench.json").string();
+}
+
+// Before the work: the JSON's folder exists (or is created) and the file can be written, so
+// that a run of minutes does not end in "cannot write". An existing file is left as it is
+// until the run is over; a probe file that did not exist is removed again.
+void check_writable(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path file(path);
+  std::error_code error;
+  if (const fs::path dir = file.parent_path(); !dir.empty()) {
+    fs::create_directories(dir, error);
+    if (error || !fs::is_directory(dir))
+      throw UsageError("cannot write the results into '" + dir.string() + "': " +
+                       (error ? error.message() : "not a directory"));
+  }
+  if (fs::is_directory(file)) throw UsageError("'" + path + "' is a directory, not a JSON file");
+  const bool existed = fs::exists(file);
+  if (!std::ofstream(file, std::ios::app))
+    throw UsageError("cannot write '" + path + "' (permissions?)");
+  if (!existed) fs::remove(file, error);
+}
+
+// The plots ./tutorial.sh bench (scripts/plot_results.py) makes of a run, in its folder: a new
+// run there removes the last run's, so that the folder never shows plots of another run.
+constexpr std::array<const char*, 4> kRunPlots = {"phases.png", "speedup.png", "allocations.png",
+                                                 "solvers.png"};
+int remove_previous_plots(const std::string& json) {
+  namespace fs = std::filesystem;
+  int removed = 0;
+  std::error_code error;
+  for (const char* name : kRunPlots)
+    removed += fs::remove(fs::path(json).parent_path() / name, error) ? 1 : 0;
+  return removed;
 }
 
 }  // namespace
@@ -563,9 +593,13 @@ int main(int argc, char** argv) {
   add_solver_options(args);
   args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
-  args.option("warmup", "N", "unmeasured steps first, >= 0", "10");
-  args.option("out", "DIR", "the run's folder: writes DIR/bench.json ('' for nowhere)", "results");
+  args.option("warmup", "N",
+              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)", "10");
+  args.option("out", "DIR",
+              "the run's folder: writes DIR/bench.json and removes the last run's plots there",
+              "results");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
+  args.flag("no-json", "write no JSON (print the tables only)");
   args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
   args.option("threads", "LIST",
               "thread counts for the parallel chapters (09 on), comma-separated (default: 1 and "
@@ -577,9 +611,13 @@ int main(int argc, char** argv) {
     const auto selected = parse_chapters(args.get("chapters"));
     const int steps = args.get_int("steps"), warmup = args.get_int("warmup");
     if (steps <= 0) throw UsageError("--steps must be positive");
-    if (warmup < 0) throw UsageError("--warmup must be >= 0");
+    if (warmup < 1)
+      throw UsageError("--warmup must be >= 1: the first step allocates the stepper's buffers, and "
+                       "the allocations per step are those of the steps after it");
     const SolverSettings solver = solver_from_args(args);
     const std::vector<int> thread_counts = parse_thread_counts(args.get("threads"));
+    const std::string path = json_path(args);
+    if (!path.empty()) check_writable(path);
     const Scene scene = scene_from_args(args);
     const BuildInfo b = build_info();
     std::cout << "fem_bench: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
@@ -591,31 +629,43 @@ int main(int argc, char** argv) {
               << "threads of the parallel chapters:";
     for (const int t : thread_counts) std::cout << " " << t;
     std::cout << (openmp_enabled() ? "" : " (built without OpenMP)") << "\n";
-    const double load_before = load_average();
-    std::cout << "load average (1 min): " << load_before << "\n";
-    if (thread_counts.size() > 1 && load_before > 0.5 * hardware_threads())
-      std::cout << "  note: the machine is busy; threads that wait for each other at barriers "
-                   "suffer most from it (the JSON records the load)\n";
+    const SourceState source = source_state();
+    std::cout << "commit " << source.commit;
+    if (!source.uncommitted.empty()) {
+      std::cout << ", with uncommitted changes in";
+      for (const auto& file : source.uncommitted) std::cout << " " << file;
+    }
+    std::cout << "\n";
+    const double others_now = other_cpus_now();
+    std::cout << "load average (1 min): " << load_average() << "; other processes use "
+              << (others_now < 0 ? std::string("?") : std::to_string(others_now).substr(0, 4))
+              << " of " << hardware_threads() << " cores now\n";
+    if (others_now > std::max(LoadMonitor::kBusyCores, 0.1 * hardware_threads()))
+      std::cout << "  note: the machine is busy; the times will show it, threads that wait for each "
+                   "other at barriers most (the JSON and the plots record it)\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
+    LoadMonitor load;
     std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";
     const std::vector<ChapterResult> results = run_chapters(selected, scene, solver, thread_counts, warmup, steps);
     print_table(results);
     std::vector<SolverResult> solvers;
     if (!args.has_flag("no-solvers")) {
-      std::cout << "\n  running the solve table ..." << std::flush;
+      std::cout << "\nrunning the solve table (every solver on the same systems)\n" << std::flush;
       solvers = run_solvers(scene, solver, warmup, steps);
       for (auto& s : run_threaded_solvers(scene, solver, thread_counts, warmup, steps))
         solvers.push_back(std::move(s));
-      std::cout << " done\n";
       print_solvers(solvers);
     }
-    if (const std::string path = json_path(args); !path.empty()) {
+    load.stop();
+    if (!path.empty()) {
       const bool replaced = std::filesystem::exists(path);
-      write_json(path, scene, solver, warmup, steps, results, solvers, load_before);
-      std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there)" : "")
-                << "\n";
+      const int removed = args.get("json").empty() ? remove_previous_plots(path) : 0;
+      write_json(path, scene, solver, warmup, steps, results, solvers, load, source);
+      std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there" : "")
+                << (replaced && removed ? ", and its plots" : "") << (replaced ? ")" : "") << "\n";
     }
+    if (const std::string warning = load.warning(); !warning.empty()) std::cerr << warning << "\n";
   } catch (const UsageError& e) {
     std::cerr << "fem_bench: " << e.what() << " (see fem_bench --help)\n";
     return 2;

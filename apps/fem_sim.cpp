@@ -2,6 +2,7 @@
 // series that ParaView opens).
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
@@ -32,6 +33,15 @@ int main(int argc, char** argv) {
     if (every < 0) throw UsageError("--every must be >= 0");
     const SolverSettings solver = solver_from_args(args);
     const int threads = threads_from_args(args);
+    // The output folder before the mesh and the steps: a place it cannot write fails at once.
+    std::optional<VtkSeries> series;
+    if (every > 0) {
+      try {
+        series.emplace(args.get("out"), args.get("scene"));
+      } catch (const std::runtime_error& e) {
+        throw UsageError(std::string("--out: ") + e.what());
+      }
+    }
     const Scene scene = scene_from_args(args);
 
     std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
@@ -41,8 +51,7 @@ int main(int argc, char** argv) {
     std::cout << "threads: " << (stepper->uses_threads() ? threads : 1)
               << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";
     State state = rest_state(scene);
-    VtkSeries series(args.get("out"), scene.name);
-    if (every > 0) series.write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+    if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
 
     const auto start = std::chrono::steady_clock::now();
     const int report_every = std::max(1, steps / 10);
@@ -52,8 +61,8 @@ int main(int argc, char** argv) {
         throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" +
                                  why +
                                  "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
-      if (every > 0 && k % every == 0)
-        series.write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+      if (series && k % every == 0)
+        series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
       if (k % report_every == 0 || k == steps) {
         const StepProfile& p = stepper->profile();
         std::cout << "  step " << k << "/" << steps << "  t = " << k * scene.dt << " s  step "
@@ -64,8 +73,8 @@ int main(int argc, char** argv) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "done in " << seconds << " s";
-    if (every > 0)
-      std::cout << "; " << series.frames() << " frames, open " << series.pvd_path()
+    if (series)
+      std::cout << "; " << series->frames() << " frames, open " << series->pvd_path()
                 << " in ParaView";
     std::cout << "\n";
   } catch (const UsageError& e) {

@@ -2,22 +2,39 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
 
 namespace fem {
 
 const std::vector<ChapterInfo>& chapters() {
   static const std::vector<ChapterInfo> list = [] {
-    std::vector<ChapterInfo> found = detail::discovered_chapters();
-    // A variant sorts right after its original, so that tables read original, variant.
-    const auto key = [](const ChapterInfo& c) {
-      return std::make_pair(c.variant_of.empty() ? c.id : c.variant_of, c.id);
-    };
-    std::stable_sort(found.begin(), found.end(),
-                     [&key](const ChapterInfo& a, const ChapterInfo& b) { return key(a) < key(b); });
+    std::vector<ChapterInfo> found = detail::in_course_order(detail::discovered_chapters());
+    // A single-threaded chapter (01-08) steps on one thread in every program: see
+    // on_one_thread (common/stepper.hpp) and why it matters (common/threads.hpp).
+    for (ChapterInfo& c : found)
+      c.make = [make = std::move(c.make)](const Scene& scene, const SolverSettings& settings) {
+        return on_one_thread(make(scene, settings), scene);
+      };
     return found;
   }();
   return list;
 }
+
+namespace detail {
+
+std::vector<ChapterInfo> in_course_order(std::vector<ChapterInfo> found) {
+  // A variant sorts right after its original (and after any variant before it in name
+  // order), so that tables read original, variant: the key is (original, is a variant, id),
+  // and "10_mine" comes after "10_multigrid" although it sorts before it by name.
+  const auto key = [](const ChapterInfo& c) {
+    return std::make_tuple(c.variant_of.empty() ? c.id : c.variant_of, !c.variant_of.empty(), c.id);
+  };
+  std::stable_sort(found.begin(), found.end(),
+                   [&key](const ChapterInfo& a, const ChapterInfo& b) { return key(a) < key(b); });
+  return found;
+}
+
+}  // namespace detail
 
 const ChapterInfo& latest_chapter() {
   const auto& list = chapters();

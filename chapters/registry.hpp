@@ -22,7 +22,8 @@ struct ChapterInfo {
   std::vector<Lesson> (*lessons)() = nullptr;
 };
 
-// Every chapter present, in order; each variant right after the chapter it came from.
+// Every chapter present, in order; each variant right after the chapter it came from. The
+// steppers their `make` returns run on one thread unless they uses_threads() (on_one_thread).
 const std::vector<ChapterInfo>& chapters();
 
 // The last chapter of the course (variants aside): the programs' default.
@@ -39,6 +40,8 @@ std::unique_ptr<Stepper> make_stepper(const std::string& chapter, const Scene& s
 namespace detail {
 // Written by the build (chapters/registry.cmake), in directory order.
 std::vector<ChapterInfo> discovered_chapters();
+// The course's order: by directory, each variant after its original (tested on its own).
+std::vector<ChapterInfo> in_course_order(std::vector<ChapterInfo> found);
 }  // namespace detail
 
 }  // namespace fem

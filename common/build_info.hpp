@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace fem {
 
@@ -16,6 +17,20 @@ BuildInfo build_info();
 // The CPU model from /proc/cpuinfo ("unknown" elsewhere) and the hardware threads.
 std::string cpu_model();
 unsigned hardware_threads();
+
+// What was measured: the commit (git describe --always --dirty --abbrev=7, "unknown" outside
+// a git checkout) and the source files that differ from it. `--dirty` sees changes to tracked
+// files only, so a student's new variant folder, untracked, would pass for the clean commit:
+// uncommitted_sources() lists changed and untracked files under the measured sources
+// (chapters/, common/, apps/, CMakeLists.txt; git status --porcelain --untracked-files=all).
+struct SourceState {
+  std::string commit;                     // with "-dirty" appended when uncommitted is not empty
+  std::vector<std::string> uncommitted;   // paths relative to the repository, e.g. "chapters/10_mine/stepper.cpp"
+  bool known = false;                     // false outside a git checkout (no git, a tarball)
+};
+SourceState source_state();
+// The JSON fields "commit": ..., "uncommitted": [...] (null when unknown).
+std::string source_state_json(const SourceState& s);
 
 // Where the repository is (meshes are found relative to it when a path is relative).
 std::string source_dir();

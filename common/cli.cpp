@@ -196,8 +196,11 @@ void add_thread_option(ArgParser& args) {
 
 int threads_from_args(const ArgParser& args) {
   if (const std::string& value = args.get("threads"); !value.empty()) {
+    const int n = args.get_int("threads");
     try {
-      set_threads(args.get_int("threads"));
+      if (const std::string warning = check_thread_count(n); !warning.empty())
+        std::cerr << "warning: --threads " << n << ": " << warning << "\n";
+      set_threads(n);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--threads: ") + e.what());
     }

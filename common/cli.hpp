@@ -58,7 +58,8 @@ SolverSettings solver_from_args(const ArgParser& args);
 // rule holds: OMP_NUM_THREADS, or every hardware thread.
 void add_thread_option(ArgParser& args);
 // Applies --threads when given; returns the thread count in use. Throws UsageError for a
-// count below 1, or above 1 in a build without OpenMP.
+// count below 1, above 1 in a build without OpenMP, or above thread_limit() (common/threads.hpp);
+// warns on stderr above the hardware threads.
 int threads_from_args(const ArgParser& args);
 
 // main()'s error handling, written once: returns body()'s exit status; a UsageError prints

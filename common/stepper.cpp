@@ -1,5 +1,7 @@
 #include "common/stepper.hpp"
 
+#include "common/threads.hpp"
+
 #include <cmath>
 #include <iostream>
 #include <stdexcept>
@@ -28,6 +30,37 @@ void Stepper::set_external_forces(const std::vector<ExternalForce>& forces) {
   f_ext_.setZero();
   for (const ExternalForce& e : forces)
     for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
+}
+
+namespace {
+
+// A single-threaded chapter's stepper, stepped on one thread. Everything else is passed on.
+class OneThreadStepper final : public Stepper {
+ public:
+  OneThreadStepper(std::unique_ptr<Stepper> inner, const Scene& scene)
+      : Stepper(scene), inner_(std::move(inner)) {}
+  void step(State& state) override {
+    const OneThreadScope one_thread;
+    inner_->step(state);
+  }
+  const StepProfile& profile() const override { return inner_->profile(); }
+  bool uses_threads() const override { return false; }
+  void set_external_forces(const std::vector<ExternalForce>& forces) override {
+    inner_->set_external_forces(forces);
+  }
+  const Eigen::SparseVector<double>& external_forces() const override {
+    return inner_->external_forces();
+  }
+
+ private:
+  std::unique_ptr<Stepper> inner_;
+};
+
+}  // namespace
+
+std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const Scene& scene) {
+  if (!stepper || stepper->uses_threads()) return stepper;
+  return std::make_unique<OneThreadStepper>(std::move(stepper), scene);
 }
 
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,

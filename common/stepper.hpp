@@ -3,6 +3,7 @@
 
 #include <Eigen/SparseCore>
 #include <chrono>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -60,16 +61,20 @@ class Stepper {
   // Advances the state by one linearized backward Euler step of scene.dt.
   virtual void step(State& state) = 0;
   virtual const StepProfile& profile() const = 0;
-  // True for the chapters whose step runs on OpenMP's thread count (09 on); the others use
-  // one thread whatever it is. The benchmark measures the first kind at each count.
+  // True for the chapters whose step runs on OpenMP's thread count (09 on); the others run
+  // on one thread whatever it is: the registry steps them inside a OneThreadScope
+  // (common/threads.hpp, on_one_thread below), and the benchmark measures the first kind at
+  // each count. A variant that threads a chapter of its own (chapter 07's exercise 3)
+  // overrides it to return true.
   virtual bool uses_threads() const { return false; }
 
   // Replaces the sparse interaction forces from the next step on: the scene's own, or
   // the viewer's mouse spring. The storage is reused, so once it has held as many
   // nonzeros this allocates nothing. Throws std::invalid_argument for a node out of
-  // range or a non-finite force.
-  void set_external_forces(const std::vector<ExternalForce>& forces);
-  const Eigen::SparseVector<double>& external_forces() const { return f_ext_; }
+  // range or a non-finite force. (Virtual only so that on_one_thread's wrapper can pass
+  // them on; no chapter overrides it.)
+  virtual void set_external_forces(const std::vector<ExternalForce>& forces);
+  virtual const Eigen::SparseVector<double>& external_forces() const { return f_ext_; }
 
  protected:
   explicit Stepper(const Scene& scene);
@@ -78,6 +83,12 @@ class Stepper {
   // a dense vector touches only those entries.
   Eigen::SparseVector<double> f_ext_;
 };
+
+// The stepper itself when it uses_threads(); otherwise a stepper that runs each of its steps
+// inside a OneThreadScope (OpenMP's and Eigen's thread counts at 1, restored after), so that
+// a single-threaded chapter runs on one thread in every program whatever --threads or
+// OMP_NUM_THREADS say. The registry's make_stepper and ChapterInfo::make return this.
+std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const Scene& scene);
 
 // Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.
 class PhaseTimer {

@@ -1,6 +1,9 @@
 #include "common/threads.hpp"
 
+#include <Eigen/Core>
 #include <stdexcept>
+
+#include "common/build_info.hpp"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -33,6 +36,48 @@ void set_threads(int n) {
     throw std::invalid_argument("this build has no OpenMP (FEM_OPENMP=OFF): only 1 thread, not " +
                                 std::to_string(n));
 #endif
+}
+
+int thread_limit() {
+  const int hardware = static_cast<int>(hardware_threads());
+  return kOversubscription * (hardware > 0 ? hardware : 1);
+}
+
+std::string check_thread_count(int n) {
+  if (n < 1) throw std::invalid_argument("the thread count must be >= 1, got " + std::to_string(n));
+  if (n > 1 && !openmp_enabled())
+    throw std::invalid_argument("this build has no OpenMP (FEM_OPENMP=OFF): only 1 thread, not " +
+                                std::to_string(n));
+  const unsigned hardware = hardware_threads();
+  if (n > thread_limit())
+    throw std::invalid_argument(
+        std::to_string(n) + " threads on a machine with " + std::to_string(hardware) +
+        " hardware threads: more than " + std::to_string(kOversubscription) +
+        " per hardware thread only wait for each other at every barrier (at most " +
+        std::to_string(thread_limit()) + ")");
+  if (hardware > 0 && static_cast<unsigned>(n) > hardware)
+    return std::to_string(n) + " threads on " + std::to_string(hardware) +
+           " hardware threads: oversubscribed, the threads take turns on the cores and wait "
+           "for each other at every barrier (expect it slower than " +
+           std::to_string(hardware) + ")";
+  return "";
+}
+
+OneThreadScope::OneThreadScope() : openmp_(max_threads()), eigen_(Eigen::nbThreads()) {
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+  Eigen::setNbThreads(1);
+}
+
+OneThreadScope::~OneThreadScope() {
+#ifdef _OPENMP
+  omp_set_num_threads(openmp_);
+#endif
+  // Eigen's count follows OpenMP's until a program sets it (Eigen::nbThreads() returns
+  // omp_get_max_threads() while the stored count is <= 0, Parallelizer.h): where it was
+  // following, it follows again (0), rather than staying frozen at the count of this moment.
+  Eigen::setNbThreads(eigen_ == openmp_ ? 0 : eigen_);
 }
 
 }  // namespace fem

@@ -1,5 +1,14 @@
-// How many threads the parallel chapters use. Chapters 01-08 are single-threaded whatever
-// this says; from chapter 09 on every OpenMP parallel region takes this count.
+// How many threads the parallel chapters use, and the one thread of the others.
+//
+// A chapter whose stepper says uses_threads() (09 on) runs every OpenMP parallel region on
+// this count. Every other chapter (01-08) runs on one thread in every program: the registry
+// (chapters/registry.cpp) wraps its stepper so that each step runs inside a OneThreadScope.
+// That matters even for chapters without a `#pragma omp` of their own: Eigen runs a
+// row-major sparse matrix times a dense vector (chapter 06's A.transpose() * p) as an OpenMP
+// `parallel for` over rows when Eigen::nbThreads() > 1 and the matrix has more than 20000
+// non-zeros (sparse_time_dense_product_impl in Eigen/src/SparseCore/SparseDenseProduct.h),
+// and Eigen::nbThreads() is omp_get_max_threads() unless Eigen::setNbThreads set it
+// (manage_multi_threading in Eigen/src/Core/products/Parallelizer.h).
 //
 // The count is OpenMP's: OMP_NUM_THREADS when the programs get no --threads, all hardware
 // threads when neither is given. Without OpenMP (FEM_OPENMP=OFF, or a compiler without it)
@@ -17,6 +26,16 @@ int max_threads();
 // n < 1, or n > 1 in a build without OpenMP.
 void set_threads(int n);
 
+// The most threads a program accepts on its command line: kOversubscription times the
+// hardware threads. More threads than cores only wait for each other at every barrier (a
+// 20-step run at --threads 999 on 2 cores took 60 times as long as at 2).
+constexpr int kOversubscription = 4;
+int thread_limit();
+// Checks a thread count asked for on the command line before any work: throws
+// std::invalid_argument for n < 1, n > 1 without OpenMP, or n > thread_limit(); returns a
+// warning to print when n is more than the hardware threads (oversubscribed), else "".
+std::string check_thread_count(int n);
+
 // Sets the thread count for a scope and restores the previous one: tests, benchmarks.
 class ThreadCountScope {
  public:
@@ -27,6 +46,19 @@ class ThreadCountScope {
 
  private:
   int previous_;
+};
+
+// One thread for a scope, OpenMP's and Eigen's own (Eigen::setNbThreads), both restored at
+// its end: what a single-threaded chapter's step runs in. Costs two stores and two loads.
+class OneThreadScope {
+ public:
+  OneThreadScope();
+  ~OneThreadScope();
+  OneThreadScope(const OneThreadScope&) = delete;
+  OneThreadScope& operator=(const OneThreadScope&) = delete;
+
+ private:
+  int openmp_, eigen_;
 };
 
 }  // namespace fem

@@ -22,8 +22,11 @@ from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # 
 
 
 def finish(fig, data, path):
-    fig.text(0.01, 0.005, footer(data), fontsize=6.5, color="0.35", ha="left", va="bottom", wrap=True)
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    text = footer(data)
+    busy = "BUSY MACHINE" in text
+    fig.text(0.01, 0.005, text, fontsize=6.5, color="firebrick" if busy else "0.35", ha="left",
+             va="bottom", wrap=True)
+    fig.tight_layout(rect=(0, 0.08 if busy else 0.05, 1, 1))
     fig.savefig(path, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
@@ -33,8 +36,28 @@ def chapter_labels(chapters):
     return [c["chapter"] for c in chapters]
 
 
-def color(c):
-    return chapter_color(c["chapter"], c.get("variant_of", ""))
+def style(c):
+    """A row's bar style: its chapter's colour (a variant in the light shade of its original's),
+    and a hatch for a row on more than one thread ("09_threads@2" beside "09_threads@1"), so that
+    the rows of one chapter at several thread counts can be told apart."""
+    threaded = c.get("threads", 1) > 1
+    return {"color": chapter_color(c["chapter"], c.get("variant_of", "")),
+            "hatch": "..." if threaded else None, "edgecolor": "white" if threaded else None,
+            "linewidth": 0}
+
+
+def legend_outside(ax, title=None):
+    """The legend right of the axes, where it covers no bar (the poster's hatched bars
+    included), one entry per row."""
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+              title=title, title_fontsize=8)
+
+
+def mark_zero(ax, x, text="0"):
+    """A phase at 0 ms (a chapter that does not have it: chapter 08's fused pass builds no
+    df/dx) gets no bar on a log axis; a small mark at the bottom says that it is zero."""
+    ax.annotate(text, (x, 0), xycoords=ax.get_xaxis_transform(), xytext=(0, 2),
+                textcoords="offset points", ha="center", va="bottom", fontsize=6, color="0.3")
 
 
 def plot_phases(data, out):
@@ -42,58 +65,89 @@ def plot_phases(data, out):
     phases = ["forces"] + PHASES
     x = np.arange(len(phases))
     width = 0.8 / len(chapters)
-    fig, ax = plt.subplots(figsize=(11, 5))
+    fig, ax = plt.subplots(figsize=(12, 5))
+    zeros = False
     for i, c in enumerate(chapters):
         med = np.array([c["median_ms"][p] for p in phases])
         lo = med - np.array([c["q1_ms"][p] for p in phases])
         hi = np.array([c["q3_ms"][p] for p in phases]) - med
-        ax.bar(x + (i - (len(chapters) - 1) / 2) * width, np.maximum(med, 1e-4), width,
-               yerr=[np.maximum(lo, 0), np.maximum(hi, 0)], capsize=2, label=c["chapter"],
-               color=color(c))
+        pos = x + (i - (len(chapters) - 1) / 2) * width
+        shown = med > 0
+        ax.bar(pos[shown], med[shown], width, yerr=[np.maximum(lo, 0)[shown], np.maximum(hi, 0)[shown]],
+               capsize=2, label=c["chapter"], **style(c))
+        for xp in pos[~shown]:
+            mark_zero(ax, xp)
+            zeros = True
     ax.set_yscale("log")
     ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
     ax.set_ylabel("median time per step [ms] (log; bars: quartiles)")
     ax.set_title(f"Time per phase of one step, chapter by chapter ({run_label(data)})")
-    ax.legend(fontsize=8, ncol=2)
+    legend_outside(ax, "0: a phase at 0 ms, no bar" if zeros else None)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "phases.png")
 
 
-def plot_speedup(data, out):
+def speedup_references(data):
+    """Which row each bar of speedup.png compares with, and what the plot then shows:
+    (pairs of (row, reference row), y-axis label, title). Chapter 01 when the run has it (the
+    poster's comparison); without it, a variant over its original at the same thread count
+    (`--chapters 10,10_mine`, the documented form of a variant's run); otherwise the first row."""
     chapters = data["chapters"]
     base = next((c for c in chapters if c["chapter"] == BASELINE), None)
-    fig, ax = plt.subplots(figsize=(11, 5))
-    if base is None or len(chapters) < 2:
-        ax.text(0.5, 0.5, "only one chapter measured: no speedup to show" if base else
-                f"no {BASELINE} in the results: no baseline", ha="center", va="center")
+    if base is not None:
+        return ([(c, base) for c in chapters if c is not base], f"speedup over {BASELINE}",
+                "Speedup per phase over the naive stepper")
+    pairs = []
+    for c in chapters:
+        original = c.get("variant_of")
+        ref = next((r for r in chapters if original and chapter_dir(r["chapter"]) == original
+                    and r.get("threads", 1) == c.get("threads", 1)), None)
+        if ref is not None:
+            pairs.append((c, ref))
+    if pairs:
+        return pairs, "speedup over its original", "Speedup per phase of each variant over its original"
+    first = chapters[0]
+    return ([(c, first) for c in chapters[1:]], f"speedup over {first['chapter']}",
+            f"Speedup per phase over {first['chapter']}")
+
+
+def plot_speedup(data, out):
+    pairs, ylabel, title = speedup_references(data)
+    fig, ax = plt.subplots(figsize=(12, 5))
+    if not pairs:
+        ax.text(0.5, 0.5, "only one chapter measured: no speedup to show", ha="center", va="center")
         ax.set_axis_off()
-        ax.set_title(f"Speedup over chapter 01 ({run_label(data)})")
+        ax.set_title(f"Speedup ({run_label(data)})")
         finish(fig, data, out / "speedup.png")
         return
-    others = [c for c in chapters if c is not base]
     # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
     phases = ["forces"] + PHASES
-    poster = comparable_to_poster(data)
-    bars = len(others) + (1 if poster else 0)
+    poster = comparable_to_poster(data) and pairs[0][1]["chapter"] == BASELINE
+    bars = len(pairs) + (1 if poster else 0)
     x = np.arange(len(phases))
     width = 0.8 / bars
-    for i, c in enumerate(others):
+    several = len({ref["chapter"] for _, ref in pairs}) > 1
+    for i, (c, ref) in enumerate(pairs):
         # A phase a chapter no longer has (chapter 08's df/dx, fused into its element pass) gets
         # no bar rather than an infinite one.
-        s = [base["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
+        s = [ref["median_ms"][p] / c["median_ms"][p] if c["median_ms"][p] > 0 else np.nan
              for p in phases]
-        ax.bar(x + (i - (bars - 1) / 2) * width, s, width, label=c["chapter"], color=color(c))
+        pos = x + (i - (bars - 1) / 2) * width
+        label = c["chapter"] + (f" / {ref['chapter']}" if several else "")
+        ax.bar(pos, s, width, label=label, **style(c))
+        for xp, v in zip(pos, s):
+            if np.isnan(v):
+                mark_zero(ax, xp, "-")
     if poster:
-        ax.bar(x + (len(others) - (bars - 1) / 2) * width,
+        ax.bar(x + (len(pairs) - (bars - 1) / 2) * width,
                [POSTER_SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
                edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
     ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
-    ax.set_ylabel(f"speedup over {BASELINE} (median ratio, log)")
-    ax.set_title("Speedup per phase over the naive stepper" + (", beside the poster's" if poster else "")
-                 + f" ({run_label(data)})")
-    ax.legend(fontsize=8, ncol=2)
+    ax.set_ylabel(f"{ylabel} (median ratio, log)")
+    ax.set_title(title + (", beside the poster's" if poster else "") + f" ({run_label(data)})")
+    legend_outside(ax, "-: a phase at 0 ms, no ratio")
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "speedup.png")
 
@@ -101,23 +155,37 @@ def plot_speedup(data, out):
 def plot_allocations(data, out):
     chapters = data["chapters"]
     counts = [c["allocations_per_step"] for c in chapters]
-    fig, ax = plt.subplots(figsize=(9, 4.5))
+    fig, ax = plt.subplots(figsize=(max(9, 0.75 * len(chapters) + 3), 5))
     bars = ax.bar(chapter_labels(chapters), [max(a, 0.5) for a in counts],
-                  color=[color(c) for c in chapters])
+                  **{k: [style(c)[k] for c in chapters] for k in ("color",)})
+    for bar, c in zip(bars, chapters):
+        if style(c)["hatch"]:
+            bar.set_hatch(style(c)["hatch"])
+            bar.set_edgecolor("white")
     for bar, a in zip(bars, counts):
         ax.annotate(f"{a:g}", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
                     ha="center", va="bottom", fontsize=9)
     ax.set_yscale("log")
     ax.set_ylim(0.3, max(counts + [1]) * 3)
     ax.set_ylabel("heap allocations per step (log; 0 drawn at 0.5)")
-    ax.set_title(f"Heap allocations per step, after the first ({run_label(data)})")
-    ax.tick_params(axis="x", rotation=20)
+    warmup = data.get("warmup_steps", 1)
+    ax.set_title("Heap allocations per step, " + ("after the first" if warmup >= 1 else
+                                                  "the first step included (no warm-up)")
+                 + f" ({run_label(data)})")
+    # Long names, variants among them: slanted, right-aligned under their bars, never overlapping.
+    plt.setp(ax.get_xticklabels(), rotation=35, ha="right", rotation_mode="anchor", fontsize=8)
     finish(fig, data, out / "allocations.png")
 
 
 def plot_solvers(data, out):
     solvers = data.get("solvers")
     if not solvers:
+        # A run folder holds one run's files: a solve table of an earlier run must not stay
+        # beside a JSON that has none.
+        stale = out / "solvers.png"
+        if stale.exists():
+            stale.unlink()
+            print(f"removed {stale}: this run has no solve table (--no-solvers)")
         return
     names = [s["name"] for s in solvers]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.8))
@@ -132,7 +200,7 @@ def plot_solvers(data, out):
         poster = [POSTER_SOLVE_MS.get(n) for n in names]
         ys = [i for i, p in enumerate(poster) if p is not None]
         ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
-    ax1.legend(fontsize=8)
+    ax1.legend(fontsize=8, loc="lower right")
     ax1.invert_yaxis()
     ax1.set_xlabel("median time per solve [ms]")
     ax1.set_title("Time per solve")

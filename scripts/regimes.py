@@ -210,8 +210,8 @@ def main():
     parser.add_argument("--plot", type=pathlib.Path, help="the PNG (default: regimes.png beside --out)")
     parser.add_argument("--plot-only", type=pathlib.Path, metavar="JSON", help="only plot an existing sweep")
     args = parser.parse_args()
-    if args.steps <= 0 or args.warmup < 0:
-        parser.error("--steps must be positive, --warmup non-negative")
+    if args.steps <= 0 or args.warmup < 1:
+        parser.error("--steps and --warmup must be positive (the first step allocates the steppers' buffers)")
 
     if args.plot_only:
         try:

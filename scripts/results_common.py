@@ -171,13 +171,39 @@ def load_checked(path, scaling=False, viewer=False):
     return data
 
 
+def uncommitted_summary(data):
+    """What a run measured beyond its commit (fem_bench's "uncommitted"): the chapter folders
+    and other files, e.g. 'chapters/10_mine/, common/stepper.cpp'; "" when nothing."""
+    files = data.get("uncommitted") or []
+    parts = []
+    for f in files:
+        p = pathlib.PurePosixPath(f)
+        part = f"chapters/{p.parts[1]}/" if len(p.parts) > 2 and p.parts[0] == "chapters" else f
+        if part not in parts:
+            parts.append(part)
+    return ", ".join(parts)
+
+
+def busy_note(data):
+    """The warning a run on a busy machine carries: other processes' CPU use during the run
+    (fem_bench's machine.busy and machine.other_cpus, common/machine_load.hpp); "" otherwise."""
+    m = data.get("machine", {})
+    if not m.get("busy"):
+        return ""
+    return (f"BUSY MACHINE: other processes used {m.get('other_cpus', '?'):.2g} of its "
+            f"{m.get('threads', '?')} cores during the run; the times are not the code's alone")
+
+
 def footer(data):
     b, m = data["build"], data["machine"]
     mesh = data.get("mesh")
     where = (f"{mesh['file']} ({mesh['nodes']} nodes, {mesh['tets']} tets), "
              f"{data['scene']}, {data.get('steps', '?')} steps, " if mesh else f"{data['scene']}, ")
+    changed = uncommitted_summary(data)
+    busy = busy_note(data)
     return (f"{where}CG tol {data['cg_tolerance']:g} | {m['cpu']} | "
-            f"{b['compiler']} {b['flags']} | Eigen {b['eigen']} | commit {data.get('commit', '?')}")
+            f"{b['compiler']} {b['flags']} | Eigen {b['eigen']} | commit {data.get('commit', '?')}"
+            + (f" + uncommitted {changed}" if changed else "") + (f"\n{busy}" if busy else ""))
 
 
 def die(message):

@@ -33,8 +33,8 @@ def main():
     parser.add_argument("--budget", type=float, default=60.0, help="seconds per run before a chapter stops")
     parser.add_argument("--no-large", action="store_true", help="only the committed beams (up to 10k nodes)")
     args = parser.parse_args()
-    if args.steps <= 0 or args.warmup < 0 or args.budget <= 0:
-        parser.error("--steps and --budget must be positive, --warmup non-negative")
+    if args.steps <= 0 or args.warmup < 1 or args.budget <= 0:
+        parser.error("--steps, --warmup and --budget must be positive (the first step allocates the steppers' buffers)")
 
     names = COMMITTED + ([] if args.no_large else LARGE)
     missing = [n for n in names if not mesh_path(n).exists()]

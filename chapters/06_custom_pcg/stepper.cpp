@@ -283,8 +283,9 @@ SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd
   // and the transposed view is a row-major product: a gather, each q_i written once. That is
   // what ConjugateGradient<M, Lower|Upper> does too (TransposeInput in ConjugateGradient.h).
   // On one core it buys no speed: both of Eigen's kernels are scalar loops
-  // (sparse_time_dense_product_impl in SparseDenseProduct.h), and fem_lessons spmv measures
-  // them within a few percent of each other. Its gain is that rows can be split over threads.
+  // (sparse_time_dense_product_impl in SparseDenseProduct.h). Its gain is that rows can be
+  // split over threads, which Eigen does with OpenMP when Eigen::nbThreads() > 1: the
+  // programs step this chapter on one thread (on_one_thread, common/stepper.hpp).
   filter(constraints, y);
   q.noalias() = A.transpose() * y;
   r = b - q;

@@ -16,7 +16,7 @@ SCRIPTS = ROOT / "scripts"
 FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
 sys.path.insert(0, str(SCRIPTS))
 import update_docs  # noqa: E402
-from results_common import validate_bench, validate_viewer  # noqa: E402
+from results_common import chapter_dir, validate_bench, validate_viewer  # noqa: E402
 
 results = {"passed": 0, "failed": 0}
 
@@ -77,6 +77,48 @@ def main():
         p = run(SCRIPTS / "plot_results.py", tmp / "missing.json", "--out", out)
         check("plot_results.py on a missing file exits 2 with a message",
               p.returncode == 2 and "no such file" in p.stderr, p.stderr)
+
+        # A variant's run without chapter 01 (--chapters 10,10_mine): each variant row over its
+        # original's row at the same thread count, never a blank plot.
+        import plot_results  # noqa: E402
+        variant_run = copy.deepcopy(bench)
+        originals = [c for c in bench["chapters"] if chapter_dir(c["chapter"]) == "09_threads"]
+        mine = []
+        for c in copy.deepcopy(originals):
+            c["chapter"] = c["chapter"].replace("09_threads", "09_mine")
+            c["variant_of"] = "09_threads"
+            c["median_ms"] = {k: v / 2 for k, v in c["median_ms"].items()}
+            mine.append(c)
+        variant_run["chapters"] = originals + mine
+        pairs, ylabel, _ = plot_results.speedup_references(variant_run)
+        check("a variant's run without 01 compares each variant row with its original's",
+              [(c["chapter"], r["chapter"]) for c, r in pairs] ==
+              [(m["chapter"], o["chapter"]) for m, o in zip(mine, originals)] and "original" in ylabel,
+              str([(c["chapter"], r["chapter"]) for c, r in pairs]))
+        check("each variant row's speedup over its original is the measured one (x2)",
+              all(r["median_ms"]["step"] / c["median_ms"]["step"] == 2.0 for c, r in pairs))
+        two = copy.deepcopy(bench)
+        two["chapters"] = [c for c in bench["chapters"] if c["chapter"] != "01_naive"][:2]
+        pairs, ylabel, _ = plot_results.speedup_references(two)
+        check("a run without 01 and without variants compares with its first row",
+              len(pairs) == 1 and pairs[0][1] is two["chapters"][0], ylabel)
+        check("rows on two threads are hatched, rows on one are not",
+              all((plot_results.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
+                  for c in bench["chapters"]) and any(c.get("threads", 1) > 1 for c in bench["chapters"]))
+
+        # A run folder holds one run's files: a run without a solve table removes the old one.
+        no_solvers = copy.deepcopy(bench)
+        del no_solvers["solvers"]
+        no_solvers["machine"] = dict(no_solvers["machine"], busy=True, other_cpus=1.5)
+        no_solvers["uncommitted"] = ["chapters/09_mine/stepper.cpp", "chapters/09_mine/README.md"]
+        (out / "bench.json").write_text(json.dumps(no_solvers))
+        p = run(SCRIPTS / "plot_results.py", out / "bench.json", "--out", out)
+        check("plots of a run without a solve table remove the folder's old solvers.png",
+              p.returncode == 0 and not (out / "solvers.png").exists(), p.stdout + p.stderr)
+        from results_common import footer  # noqa: E402
+        check("the footer says the machine was busy and what was measured beyond the commit",
+              "BUSY MACHINE" in footer(no_solvers) and "uncommitted chapters/09_mine/" in footer(no_solvers),
+              footer(no_solvers))
 
         # Tables: a copy of the docs with the markers, filled from the fixture.
         root = tmp / "repo"

@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""The exercises of chapters 01-06 as a student does them: in a copy of the repository (the
+current files, committed or not), make each code-changing exercise's variant with
+`./tutorial.sh variant`, apply a small scripted version of the exercise's change, build, and
+run the commands the chapter README gives, checking that
+
+  - each command is written in the README as run here (NAME replaced by the variant's name),
+  - it succeeds, or fails where the exercise says a test fails,
+  - and it measured the variant, not the original: the variant's row is in fem_bench's table
+    and differs from the original's as the change must make it differ.
+
+Not covered: 03/3 (a debug build), the exercises that change no code, and chapters 07-10.
+Prints 'N passed, M failed' last; about five minutes on 2 cores (one build of every chapter
+and five variants).
+
+    test_exercises.py [--keep DIR]"""
+import argparse
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+results = {"passed": 0, "failed": 0}
+
+
+def check(name, condition, detail=""):
+    results["passed" if condition else "failed"] += 1
+    print(f"{'ok  ' if condition else 'FAIL'} {name}{'' if condition else ': ' + str(detail)[-3000:]}",
+          flush=True)
+    return condition
+
+
+# The exercises: chapter, variant name, the text replaced in the variant's stepper.cpp (the
+# scripted change), and the README commands to run (NAME stands for the variant's name).
+EXERCISES = [
+    {"id": "01/2", "chapter": "01", "name": "ex_setzero",
+     "change": [("dfdx_.coeffs().setZero();", "dfdx_.setZero();")],
+     "bench": "build/release/fem_bench --chapters 01,01_NAME --steps 5 --no-solvers --no-json",
+     "expect": "more allocations",
+     "test": "./tutorial.sh test -L ch01_NAME", "test_passes": True},
+    {"id": "02/1", "chapter": "02", "name": "ex_alias",
+     "change": [("b_.noalias() = h * (dfdx_ * scaled_v_);", "b_ = h * (dfdx_ * scaled_v_);")],
+     "bench": "build/release/fem_bench --chapters 02,02_NAME --steps 5 --no-solvers --no-json",
+     "expect": "more allocations"},
+    {"id": "05/1", "chapter": "05", "name": "ex_nodiag",
+     "change": [("block(A_, c.node, diagonal_block_[c.node]) += Eigen::Matrix3d::Identity() - c.filter;",
+                 "(void)diagonal_block_;")],
+     "test": "./tutorial.sh test -L ch05_NAME", "test_passes": False,
+     "failing": "matches chapter 01"},
+    {"id": "06/1", "chapter": "06", "name": "ex_colmajor",
+     "change": [("q.noalias() = A.transpose() * y;", "q.noalias() = A * y;"),
+                ("q.noalias() = A.transpose() * p;", "q.noalias() = A * p;")],
+     "bench": "build/release/fem_bench --chapters 06,06_NAME --steps 30 --no-solvers --no-json",
+     "expect": "same iterations"},
+    {"id": "06/2", "chapter": "06", "name": "ex_cold",
+     "change": [("  // Warm start: y_ still holds the previous step's answer; pcg_solve filters it.\n",
+                 "  y_.setZero();  // the warm start off\n")],
+     "bench": "build/release/fem_bench --chapters 06,06_NAME --steps 30 --no-solvers --no-json",
+     "expect": "more iterations"},
+    {"id": "06/3", "chapter": "06", "name": "ex_nofilter",
+     "change": [("      r -= step * q;\n      filter(constraints, r);\n", "      r -= step * q;\n"),
+                ("      s = inverse_diagonal.cwiseProduct(r);\n      filter(constraints, s);\n",
+                 "      s = inverse_diagonal.cwiseProduct(r);\n")],
+     "test": "./tutorial.sh test -R 06_NAME", "test_passes": False,
+     "failing": "constrained velocities are the prescribed ones"},
+]
+
+
+def run(cwd, command, env=None):
+    return subprocess.run(command, cwd=cwd, shell=True, capture_output=True, text=True, env=env)
+
+
+def copy_repository(target):
+    """The repository's current files (tracked and untracked, not ignored) and a link to its
+    .venv: what a student's clone with the student's own changes holds."""
+    listed = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others",
+                             "--exclude-standard"], capture_output=True, check=True).stdout
+    for rel in filter(None, listed.decode().split("\0")):
+        source = ROOT / rel
+        if not source.is_file() or rel.startswith("chapters/") and "/" in rel[9:] and \
+                (ROOT / "chapters" / rel.split("/")[1] / "variant_of").exists():
+            continue  # the student's own variants stay out of the copy
+        (target / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, target / rel)
+    (target / ".venv").symlink_to((ROOT / ".venv").resolve())
+
+
+def bench_rows(stdout):
+    """fem_bench's first table: chapter -> (allocations per step, CG iterations)."""
+    rows, inside = {}, False
+    for line in stdout.splitlines():
+        if line.startswith("median ms per step"):
+            inside = True
+            continue
+        if inside and not line.strip():
+            if rows:
+                break
+            continue
+        if inside and not line.startswith("chapter"):
+            cells = line.split()
+            rows[cells[0]] = (float(cells[7]), float(cells[8]))
+    return rows
+
+
+def readme_has(chapter_dir, command):
+    """The README gives the command (NAME as the placeholder), wrapped over lines or not."""
+    text = re.sub(r"\s+", " ", (chapter_dir / "README.md").read_text())
+    return f"`{command}`" in text
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--keep", type=pathlib.Path, help="work in this folder and keep it")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        repo = args.keep or pathlib.Path(tmp) / "clone"
+        if repo.exists():
+            shutil.rmtree(repo)
+        repo.mkdir(parents=True)
+        copy_repository(repo)
+        env = dict(os.environ, OMP_WAIT_POLICY="passive")
+
+        # The variants, made and changed as the READMEs say.
+        originals = {}
+        for ex in EXERCISES:
+            chapter_dir = next(d for d in sorted((repo / "chapters").iterdir())
+                               if d.name.startswith(ex["chapter"] + "_") and (d / "stepper.hpp").exists())
+            originals[ex["chapter"]] = chapter_dir
+            check(f"{ex['id']}: the README says how to make the variant",
+                  readme_has(chapter_dir, f"./tutorial.sh variant {ex['chapter']} NAME"))
+            p = run(repo, f"./tutorial.sh variant {ex['chapter']} {ex['name']}", env)
+            if not check(f"{ex['id']}: ./tutorial.sh variant {ex['chapter']} {ex['name']}",
+                         p.returncode == 0, p.stdout + p.stderr):
+                continue
+            source = repo / "chapters" / f"{ex['chapter']}_{ex['name']}" / "stepper.cpp"
+            text = source.read_text()
+            for old, new in ex["change"]:
+                check(f"{ex['id']}: the code the exercise changes is there ({old.strip()[:50]})",
+                      old in text, source)
+                text = text.replace(old, new)
+            source.write_text(text)
+
+        p = run(repo, "cmake --preset release > configure.log 2>&1 && "
+                      "cmake --build --preset release --target fem_bench test_every_chapter", env)
+        if not check("the copy with its variants configures and builds", p.returncode == 0,
+                     p.stdout[-3000:] + p.stderr[-3000:] + (repo / "configure.log").read_text()[-2000:]
+                     if (repo / "configure.log").exists() else p.stderr):
+            print(f"{results['passed']} passed, {results['failed']} failed")
+            return 1
+
+        for ex in EXERCISES:
+            variant = f"{ex['chapter']}_{ex['name']}"
+            chapter_dir = originals[ex["chapter"]]
+            if "bench" in ex:
+                command = ex["bench"]
+                check(f"{ex['id']}: the README gives `{command}`", readme_has(chapter_dir, command))
+                results_before = sorted((repo / "results").glob("**/*")) if (repo / "results").exists() else []
+                p = run(repo, command.replace("NAME", ex["name"]), env)
+                if not check(f"{ex['id']}: {command} runs", p.returncode == 0, p.stdout + p.stderr):
+                    continue
+                rows = bench_rows(p.stdout)
+                original, changed = rows.get(chapter_dir.name), rows.get(variant)
+                check(f"{ex['id']}: fem_bench measured the variant beside the original",
+                      original is not None and changed is not None, p.stdout[-2000:])
+                if original is None or changed is None:
+                    continue
+                if ex["expect"] == "more allocations":
+                    check(f"{ex['id']}: the variant allocates more per step "
+                          f"({changed[0]:g} against {original[0]:g})", changed[0] > original[0])
+                elif ex["expect"] == "more iterations":
+                    check(f"{ex['id']}: the variant needs more CG iterations "
+                          f"({changed[1]:g} against {original[1]:g})", changed[1] > original[1])
+                elif ex["expect"] == "same iterations":
+                    check(f"{ex['id']}: the variant needs the same CG iterations "
+                          f"({changed[1]:g} against {original[1]:g})", abs(changed[1] - original[1]) <= 1)
+                after = sorted((repo / "results").glob("**/*")) if (repo / "results").exists() else []
+                check(f"{ex['id']}: --no-json wrote no results", after == results_before, after)
+            if "test" in ex:
+                command = ex["test"]
+                check(f"{ex['id']}: the README gives `{command}`", readme_has(chapter_dir, command))
+                # ./tutorial.sh test builds everything first; the copy built what these tests
+                # need, so ctest with the same selection runs them.
+                selection = command.replace("./tutorial.sh test", "").replace("NAME", ex["name"]).strip()
+                p = run(repo, f"ctest --preset release {selection}", env)
+                ran = re.findall(r"Test +#\d+: (.*?) \.+", p.stdout)
+                check(f"{ex['id']}: `{command}` runs the variant's tests and only those",
+                      len(ran) >= 4 and all(name.startswith(variant + ":") for name in ran), p.stdout[-2000:])
+                if ex["test_passes"]:
+                    check(f"{ex['id']}: the variant's tests pass", p.returncode == 0, p.stdout[-2000:])
+                else:
+                    failed = re.findall(rf"\d+ - ({re.escape(variant)}: .*?) \(Failed\)", p.stdout)
+                    check(f"{ex['id']}: the variant's tests fail, `{ex['failing']}` among them",
+                          p.returncode != 0 and any(ex["failing"] in f for f in failed),
+                          p.stdout[-2000:])
+    print(f"{results['passed']} passed, {results['failed']} failed")
+    return 1 if results["failed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
