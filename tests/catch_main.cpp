@@ -12,7 +12,8 @@ namespace {
 bool ran_no_test_case = false;
 
 struct NoTestCaseListener : fem::test::EventListenerBase {
-  using EventListenerBase::EventListenerBase;
+  using Base = fem::test::EventListenerBase;
+  using Base::Base;
   void testRunEnded(const Catch::TestRunStats& stats) override {
     ran_no_test_case = stats.totals.testCases.total() == 0;
   }
