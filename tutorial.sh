@@ -6,7 +6,7 @@ set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$ROOT"
-PRESET="${PRESET:-release}"           # release | debug | asan
+PRESET="${PRESET:-release}"           # release | debug | asan | clang | catch2-3
 BUILD_DIR="$ROOT/build/$PRESET"
 VENV="$ROOT/.venv"
 
@@ -21,6 +21,12 @@ APT_PACKAGES=(
   # screenshots; Xvfb and Mesa's software renderer run it headless in the tests
   pkg-config libglfw3-dev libgl-dev libimgui-dev libstb-dev xvfb xauth libgl1-mesa-dri
 )
+# What the other presets add: the clang preset builds with Clang and its OpenMP runtime; the
+# catch2-3 preset unpacks Catch2 3 from bookworm-backports into build/ (scripts/catch2_3.sh,
+# which installs nothing).
+case "$PRESET" in
+  clang) APT_PACKAGES+=(clang libomp-dev) ;;
+esac
 
 usage() {
   cat <<USAGE
@@ -69,7 +75,13 @@ commands:
   help       this text (also --help, -h)
 
 environment:
-  PRESET=release|debug|asan   which CMake preset to build and test with (default release)
+  PRESET=release|debug|asan|clang|catch2-3
+                 which CMake preset to build and test with (default release; clang: compiled by
+                 Clang; catch2-3: tested with Catch2 3, fetched into build/deps/ by
+                 scripts/catch2_3.sh; CMakePresets.json)
+  FEM_SKIP_PACKAGES=1
+                 do not check or install system packages (for systems without apt-get, once
+                 their packages are installed by hand: README, "Other systems")
 USAGE
 }
 
@@ -84,8 +96,28 @@ missing_packages() {
   done
 }
 
+# Where there is no apt-get (Fedora, macOS, ...), the script cannot install anything: it says
+# so, with the packages to install by hand, and stops.
+refuse_without_apt() {
+  cat >&2 <<REFUSE
+tutorial.sh installs its system packages with apt-get (Debian, Ubuntu), and this system has
+no apt-get. Install them by hand (README, "Other systems"), for example:
+  Fedora:           sudo dnf install gcc-c++ cmake ninja-build git python3 eigen3-devel \\
+                      catch-devel suitesparse-devel glfw-devel mesa-libGL-devel \\
+                      xorg-x11-server-Xvfb mesa-dri-drivers
+  macOS (Homebrew): brew install cmake ninja python eigen catch2 libomp glfw
+then run the same command again with FEM_SKIP_PACKAGES=1, e.g.
+  FEM_SKIP_PACKAGES=1 ./tutorial.sh test
+(CMake then reports anything still missing; the viewer is built only where Dear ImGui and stb
+are found, and is skipped otherwise.)
+REFUSE
+  exit 1
+}
+
 # Installs the missing ones of the arguments (default: all of APT_PACKAGES).
 install_system_packages() {
+  [ "${FEM_SKIP_PACKAGES:-0}" = 1 ] && return 0
+  command -v apt-get >/dev/null && command -v dpkg-query >/dev/null || refuse_without_apt
   local missing
   command -v dpkg-query >/dev/null || return 0  # not Debian: the user installs them (README)
   missing=$(missing_packages "$@" | tr '\n' ' ')
@@ -118,6 +150,9 @@ setup_venv() {
 }
 
 configure() {
+  if [ "$PRESET" = catch2-3 ]; then
+    scripts/catch2_3.sh >/dev/null
+  fi
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     log "configuring (preset $PRESET)"
     cmake --preset "$PRESET"

@@ -7,6 +7,10 @@ only, so the host needs none of the instruction sets. Exits 1 on any "warning:".
 
     .venv/bin/python scripts/check_warnings.py                     # x86-64-v3 and x86-64-v4
     .venv/bin/python scripts/check_warnings.py --march x86-64-v4 --jobs 2
+    .venv/bin/python scripts/check_warnings.py --cxx clang++       # the same for Clang
+
+The default compiler is CMake's (GCC on Debian); with --cxx the build folders are named after
+it (build/march-clang++-x86-64-v3), so the two never share a CMake cache.
 """
 import argparse
 import concurrent.futures
@@ -21,10 +25,11 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
-def configure(march, build_dir):
+def configure(march, build_dir, cxx=None):
+    compiler = [f"-DCMAKE_CXX_COMPILER={cxx}"] if cxx else []
     subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build_dir), "-G", "Ninja",
                     "-DCMAKE_BUILD_TYPE=Release", "-DFEM_NATIVE=OFF",
-                    f"-DCMAKE_CXX_FLAGS=-march={march}"],
+                    f"-DCMAKE_CXX_FLAGS=-march={march}", *compiler],
                    check=True, stdout=subprocess.DEVNULL)
     return json.loads((build_dir / "compile_commands.json").read_text())
 
@@ -45,12 +50,15 @@ def main():
                         "default x86-64-v3 and x86-64-v4")
     parser.add_argument("--build-root", type=pathlib.Path, default=ROOT / "build")
     parser.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
+    parser.add_argument("--cxx", help="the C++ compiler (default: CMake's choice, GCC on Debian)")
     args = parser.parse_args()
     failed = False
     for march in args.march or ["x86-64-v3", "x86-64-v4"]:
-        build_dir = args.build_root / f"march-{march}"
-        entries = [e for e in configure(march, build_dir) if pathlib.Path(e["file"]).exists()]
-        print(f"-march={march}: compiling {len(entries)} sources in {build_dir} "
+        name = f"march-{march}" if not args.cxx else f"march-{pathlib.Path(args.cxx).name}-{march}"
+        build_dir = args.build_root / name
+        entries = [e for e in configure(march, build_dir, args.cxx)
+                   if pathlib.Path(e["file"]).exists()]
+        print(f"{args.cxx or 'c++'} -march={march}: compiling {len(entries)} sources in {build_dir} "
               f"({args.jobs} at a time)", flush=True)
         warnings = errors = 0
         with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
@@ -63,7 +71,7 @@ def main():
                       f"{f', {count} warnings' if count else ''}{', FAILED' if rc else ''}", flush=True)
                 if count or rc:
                     print(output[:4000])
-        print(f"-march={march}: {warnings} warnings, {errors} failed compilations")
+        print(f"{args.cxx or 'c++'} -march={march}: {warnings} warnings, {errors} failed compilations")
         failed |= warnings > 0 or errors > 0
     return 1 if failed else 0
 

@@ -1,18 +1,19 @@
-// Debian's Catch2WithMain is built without benchmarking support, so the tests keep
-// their own main with CATCH_CONFIG_ENABLE_BENCHMARKING. It also refuses a run in which no
-// test case matched: Catch2 2.x exits 0 then, so a ctest entry whose name had been mangled
-// (a ';' splits a name in CMake) would pass without running anything.
-#define CATCH_CONFIG_RUNNER
-#define CATCH_CONFIG_ENABLE_BENCHMARKING
-#include <catch2/catch.hpp>
+// The main of every test binary, for Catch2 2 and 3 alike (tests/catch2_compat.hpp). It
+// refuses a run in which no test case matched: Catch2 2.x exits 0 then, so a ctest entry
+// whose name had been mangled (a ';' splits a name in CMake) would pass without running
+// anything. (Catch2 3 refuses such a run itself, with exit code 2; the rule is ours either way.)
+#define FEM_CATCH_MAIN
 #include <iostream>
+
+#include "catch2_compat.hpp"
 
 namespace {
 
 bool ran_no_test_case = false;
 
-struct NoTestCaseListener : Catch::TestEventListenerBase {
-  using TestEventListenerBase::TestEventListenerBase;
+struct NoTestCaseListener : fem::test::EventListenerBase {
+  using Base = fem::test::EventListenerBase;
+  using Base::Base;
   void testRunEnded(const Catch::TestRunStats& stats) override {
     ran_no_test_case = stats.totals.testCases.total() == 0;
   }

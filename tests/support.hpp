@@ -3,11 +3,11 @@
 #pragma once
 
 #include <algorithm>
-#include <catch2/catch.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "catch2_compat.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
 #include "common/mesh.hpp"

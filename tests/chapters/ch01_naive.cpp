@@ -1,8 +1,8 @@
 // Chapter 01: the naive stepper is the reference every other chapter is checked
 // against, so its own tests check the system it builds.
 #include <Eigen/Cholesky>
-#include <catch2/catch.hpp>
 
+#include "catch2_compat.hpp"
 #include "chapters/01_naive/stepper.hpp"
 #include "common/alloc_counter.hpp"
 #include "support.hpp"

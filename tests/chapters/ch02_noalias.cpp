@@ -1,7 +1,6 @@
 // Chapter 02: the same physics as chapter 01, fewer allocations, and the per-statement
 // counts that the chapter's README shows.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "chapters/02_noalias/statements.hpp"
 #include "common/alloc_counter.hpp"
 #include "support.hpp"

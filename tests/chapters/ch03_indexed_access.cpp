@@ -1,6 +1,5 @@
 // Chapter 03: the offset table fills df/dx exactly as coeffRef does, without searching.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "chapters/02_noalias/stepper.hpp"
 #include "chapters/03_indexed_access/stepper.hpp"
 #include "common/alloc_counter.hpp"

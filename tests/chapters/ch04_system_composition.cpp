@@ -1,6 +1,5 @@
 // Chapter 04: A composed in one pass over the value arrays equals the sparse expression.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "chapters/03_indexed_access/stepper.hpp"
 #include "chapters/04_system_composition/stepper.hpp"
 #include "support.hpp"

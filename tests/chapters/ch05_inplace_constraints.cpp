@@ -1,7 +1,7 @@
 // Chapter 05: the filter applied in place equals the explicit S A S^T + I - S.
 #include <Eigen/Cholesky>
-#include <catch2/catch.hpp>
 
+#include "catch2_compat.hpp"
 #include "chapters/01_naive/stepper.hpp"
 #include "chapters/05_inplace_constraints/stepper.hpp"
 #include "support.hpp"

@@ -1,7 +1,7 @@
 // Chapter 06: our PCG solves what Eigen's CG solves, and the step allocates nothing.
 #include <Eigen/Cholesky>
-#include <catch2/catch.hpp>
 
+#include "catch2_compat.hpp"
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "support.hpp"
 

@@ -1,7 +1,6 @@
 // Chapter 07: the block sparse matrix computes what Eigen's computes, and the stepper
 // still matches chapter 01 without allocating.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "chapters/05_inplace_constraints/stepper.hpp"
 #include "chapters/07_block_sparse/lesson.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"

@@ -2,9 +2,9 @@
 // common/'s dfdx_block, the fused pass builds chapter 07's system, and the stepper still
 // matches chapter 01 without allocating.
 #include <Eigen/SVD>
-#include <catch2/catch.hpp>
 #include <random>
 
+#include "catch2_compat.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
 #include "support.hpp"

@@ -1,9 +1,9 @@
 // Chapter 09: the same answer, to the last bit, for any thread count; the same physics as
 // chapter 01; no allocation per step with threads; and a long run under a random mouse
 // spring for every chapter from 07 on.
-#include <catch2/catch.hpp>
 #include <random>
 
+#include "catch2_compat.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/09_threads/stepper.hpp"
 #include "common/model.hpp"

@@ -2,8 +2,7 @@
 // definite on the filtered space), its coarse matrices are the Galerkin products, it cuts the
 // iterations, the state is the same to the last bit on 1 and 2 threads, and the stepper still
 // matches chapter 01 without allocating.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/threads.hpp"

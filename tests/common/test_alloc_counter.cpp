@@ -1,9 +1,9 @@
 // The allocation counter counts known allocations exactly.
 #include <Eigen/SparseCore>
-#include <catch2/catch.hpp>
 #include <cstdlib>
 #include <vector>
 
+#include "catch2_compat.hpp"
 #include "common/alloc_counter.hpp"
 
 using namespace fem;

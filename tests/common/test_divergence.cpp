@@ -1,9 +1,9 @@
 // divergence(): the rule that turns a step into a failure the programs stop on. A solve
 // that did not converge by far (nu = 0.4999999: CG at its cap with a relative residual
 // above 1) is reported as clearly as a NaN; a capped solve close to the tolerance is not.
-#include <catch2/catch.hpp>
 #include <string>
 
+#include "catch2_compat.hpp"
 #include "support.hpp"
 
 using namespace fem;

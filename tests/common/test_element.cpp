@@ -1,8 +1,8 @@
 // The corotated element kernels against finite differences.
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
 #include <cmath>
 
+#include "catch2_compat.hpp"
 #include "common/element.hpp"
 
 using namespace fem;

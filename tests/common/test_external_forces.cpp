@@ -62,11 +62,11 @@ TEST_CASE("bad external forces are refused with the reason", "[external]") {
   auto stepper = make_stepper("06", scene);
   const int n = scene.mesh.num_nodes();
   CHECK_THROWS_WITH(stepper->set_external_forces({{n, Eigen::Vector3d::UnitZ()}}),
-                    Catch::Contains("not in [0, " + std::to_string(n) + ")"));
+                    test::contains_text("not in [0, " + std::to_string(n) + ")"));
   CHECK_THROWS_WITH(stepper->set_external_forces({{-1, Eigen::Vector3d::UnitZ()}}),
-                    Catch::Contains("node -1"));
+                    test::contains_text("node -1"));
   CHECK_THROWS_WITH(stepper->set_external_forces({{0, Eigen::Vector3d(std::nan(""), 0.0, 0.0)}}),
-                    Catch::Contains("not finite"));
+                    test::contains_text("not finite"));
 }
 
 TEST_CASE("moving the spring from node to node allocates nothing once the storage is sized",

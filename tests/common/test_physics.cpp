@@ -1,7 +1,6 @@
 // The physics of the step, checked on the reference stepper (chapter 01): momentum,
 // energy, constraints. Every other chapter is checked against chapter 01.
-#include <catch2/catch.hpp>
-
+#include "catch2_compat.hpp"
 #include "common/model.hpp"
 #include "support.hpp"
 

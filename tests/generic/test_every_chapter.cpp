@@ -4,12 +4,11 @@
 // scenes, its allocations per step are deterministic (none if its original has none), its
 // state is the same to the last bit on 1, 2 and 3 threads, and it meets its constraints as
 // exactly as its original. Labels: "chapters", and the chapter's own (ch06, ch06_NAME).
-#include <catch2/catch.hpp>
 #include <algorithm>
-#include <deque>
 #include <string>
 #include <utility>
 
+#include "catch2_compat.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
 
@@ -100,37 +99,18 @@ void constraints_hold(const ChapterInfo& chapter) {
   }
 }
 
-// A Catch2 test case bound to one chapter: Catch2 2.x registers function pointers, so a
-// chapter-parametrized case is an invoker object holding the chapter.
-class ChapterTest final : public Catch::ITestInvoker {
- public:
-  ChapterTest(void (*check)(const ChapterInfo&), const ChapterInfo& chapter)
-      : check_(check), chapter_(chapter) {}
-  void invoke() const override { check_(chapter_); }
-
- private:
-  void (*check_)(const ChapterInfo&);
-  const ChapterInfo& chapter_;
-};
-
-// Names and tags live as long as the program (a deque never moves its elements). Catch2
-// takes ownership of the invoker (its TestCase holds it in a shared_ptr), hence the new.
+// One test case per chapter and check, made at run time from the registry.
 const bool registered = [] {
-  static std::deque<std::string> texts;
   for (const ChapterInfo& chapter : chapters()) {
     const std::pair<const char*, void (*)(const ChapterInfo&)> checks[] = {
         {"matches chapter 01 on both scenes over 50 steps", matches_ch01},
         {"allocations per step are the same every step", allocations},
         {"the same state to the last bit on 1, 2 and 3 threads", same_state_on_any_thread_count},
         {"constrained velocities are the prescribed ones", constraints_hold}};
-    for (const auto& [what, check] : checks) {
-      texts.push_back(chapter.id + ": " + what);
-      const std::string& name = texts.back();
-      texts.push_back("[every_chapter][" + chapter.id + "]");
-      const std::string& tags = texts.back();
-      Catch::AutoReg(new ChapterTest(check, chapter), CATCH_INTERNAL_LINEINFO, Catch::StringRef(),
-                     Catch::NameAndTags{name, tags});
-    }
+    for (const auto& [what, check] : checks)
+      test::register_test_case(chapter.id + ": " + what, "[every_chapter][" + chapter.id + "]",
+                               [check = check, &chapter] { check(chapter); },
+                               Catch::SourceLineInfo(__FILE__, __LINE__));
   }
   return true;
 }();
