@@ -80,6 +80,7 @@ def sweep(args):
                 data = run_point(args, body, e, pathlib.Path(tmp) / f"point{k}.json")
                 if result is None:
                     result = {key: data[key] for key in HEADER_KEYS}
+                    result["uncommitted"] = data.get("uncommitted")  # what differs from the commit
                     result.update({"knob": "E", "bodies": [b.stem for b in bodies], "E_values": args.E,
                                    "chapters_option": args.chapters})
                 point = {"body": body.stem, "E": e, "mesh": data["mesh"], "material": data["material"],

@@ -108,6 +108,14 @@ def validate_bench(data):
     machine = need(data, "machine", dict, "bench")
     if machine is not None:
         need(machine, "cpu", str, "machine")
+        if "busy" in machine and not isinstance(machine["busy"], bool):
+            problems.append(f"machine.busy: expected a bool, got {machine['busy']!r}")
+        if machine.get("other_cpus") is not None:
+            need(machine, "other_cpus", float, "machine")
+    uncommitted = data.get("uncommitted")
+    if uncommitted is not None and not (isinstance(uncommitted, list) and
+                                        all(isinstance(f, str) for f in uncommitted)):
+        problems.append(f"bench.uncommitted: expected a list of paths or null, got {uncommitted!r}")
     need(data, "commit", str, "bench")
     chapters = need(data, "chapters", list, "bench")
     if chapters is not None and not chapters:

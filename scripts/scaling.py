@@ -83,7 +83,7 @@ def main():
     result = {"schema_version": 1, "scene": header["scene"], "steps": args.steps,
               "warmup_steps": args.warmup, "dt": header["dt"], "cg_tolerance": header["cg_tolerance"],
               "build": header["build"], "machine": header["machine"], "commit": header["commit"],
-              "budget_seconds": args.budget, "runs": runs, "skipped": skipped}
+              "uncommitted": header.get("uncommitted"), "budget_seconds": args.budget, "runs": runs, "skipped": skipped}
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(result, indent=1) + "\n")

@@ -60,6 +60,12 @@ def machine_table(data):
             ("scene", data["scene"]),
             ("steps", f"{data['warmup_steps']} warm-up + {data['steps']} measured, dt = {data['dt']:g} s"),
             ("CG", f"relative tolerance {data['cg_tolerance']:g}, at most {data['cg_max_iterations']} iterations")]
+    if m.get("other_cpus") is not None:
+        rows.append(("machine load", f"other processes used {m['other_cpus']:.2g} of {m.get('threads', '?')} "
+                                     f"cores during the run" + (" (**busy**: the times are not the code's alone)"
+                                                                if m.get("busy") else "")))
+    if data.get("uncommitted"):
+        rows.append(("uncommitted", ", ".join(f"`{f}`" for f in data["uncommitted"])))
     if "material" in data:
         mat = data["material"]
         rows.append(("material", f"E = {mat['E']:g} Pa, nu = {mat['nu']:g}, rho = {mat['rho']:g} kg/m^3, "

@@ -28,10 +28,20 @@ def chapter_ids():
 
 
 def git_commit():
-    # As fem_bench records it: a run from uncommitted code says so.
+    """As fem_bench records it (common/build_info.hpp, source_state): a run from uncommitted
+    code says so, untracked files under the measured sources (a new variant) included, which
+    `git describe --dirty` alone does not see."""
     run = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty", "--abbrev=7"],
                          capture_output=True, text=True)
-    return run.stdout.strip() if run.returncode == 0 else "unknown"
+    if run.returncode != 0:
+        return "unknown"
+    commit = run.stdout.strip()
+    status = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=all",
+                             "--", "chapters", "common", "apps", "CMakeLists.txt", "CMakePresets.json"],
+                            capture_output=True, text=True)
+    if status.returncode == 0 and status.stdout.strip() and not commit.endswith("-dirty"):
+        commit += "-dirty"
+    return commit
 
 
 def run_one(viewer, mesh, chapter, frames, size, report):

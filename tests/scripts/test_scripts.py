@@ -195,6 +195,12 @@ def main():
         broken = copy.deepcopy(bench)
         broken["cg_tolerance"] = "tight"
         check("a wrong type is caught", validate_bench(broken) != [])
+        broken = copy.deepcopy(bench)
+        broken["machine"]["busy"] = "yes"
+        check("a busy flag that is not a bool is caught", validate_bench(broken) != [])
+        broken = copy.deepcopy(bench)
+        broken["uncommitted"] = "chapters/10_mine"
+        check("an uncommitted list that is not a list is caught", validate_bench(broken) != [])
         bad = tmp / "broken.json"
         bad.write_text(json.dumps(broken))
         p = run(SCRIPTS / "validate_bench.py", bad)
