@@ -14,6 +14,7 @@
 #include "common/cli.hpp"
 #include "common/json.hpp"
 #include "common/lesson.hpp"
+#include "common/machine_load.hpp"
 #include "common/threads.hpp"
 
 namespace {
@@ -78,6 +79,23 @@ void check_writable(const std::string& path) {
   if (!std::ofstream(path, std::ios::app)) throw UsageError("--json " + path + ": cannot write there");
 }
 
+// The lesson's table, on one thread unless the lesson measures threads; a run on a busy
+// machine says so under the table (and on stderr).
+std::string measure(const Lesson& lesson, const LessonRun& run) {
+  LoadMonitor load;
+  std::string table;
+  if (lesson.uses_threads) {
+    table = lesson.table(run);
+  } else {
+    const OneThreadScope one_thread;
+    table = lesson.table(run);
+  }
+  load.stop();
+  if (!load.busy()) return table;
+  std::cerr << "fem_lessons " << lesson.name << ": " << load.warning() << "\n";
+  return table + "\n**Measured on a busy machine:** " + load.warning() + "\n";
+}
+
 // Runs one lesson; argv[0] is its name. A variant's table is printed after the original's.
 int run_lesson(const Found& found, int argc, char** argv) {
   const std::string program = "fem_lessons " + found.lesson.name;
@@ -107,7 +125,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
     if (!json.empty()) check_writable(json);
     for (const auto& [chapter, lesson] : runs) {
       if (runs.size() > 1) std::cout << "\n### " << chapter->id << "\n\n";
-      const std::string table = lesson.table({args, scene, steps, chapter->id});
+      const std::string table = measure(lesson, {args, scene, steps, chapter->id});
       std::cout << table << std::flush;
       if (!readme.empty()) {
         write_between_markers(readme, lesson.name + "-table", table);

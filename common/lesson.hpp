@@ -31,6 +31,9 @@ struct Lesson {
   std::function<void(ArgParser&)> add_options;
   // The lesson's Markdown table (and the sentence under it that says how it was measured).
   std::function<std::string(const LessonRun&)> table;
+  // False: the table is measured on one thread (OpenMP's and Eigen's counts at 1), as the
+  // chapters before 09 run; true: at the thread counts the lesson chooses (--threads).
+  bool uses_threads = false;
 };
 
 // ---- what the measurements share ----------------------------------------------------------

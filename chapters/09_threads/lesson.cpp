@@ -106,7 +106,7 @@ std::string threads_element_table(const Scene& scene, int steps) {
 
 std::vector<Lesson> lessons() {
   return {{"threads-element", "the element pass: colouring against per-node gather, and the block SpMV, at 1 and all threads", "meshes/plate_poster.msh", nullptr,
-           [](const LessonRun& run) { return threads_element_table(run.scene, run.steps); }}};
+           [](const LessonRun& run) { return threads_element_table(run.scene, run.steps); }, true}};
 }
 
 }  // namespace fem::ch09

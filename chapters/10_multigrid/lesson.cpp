@@ -243,7 +243,7 @@ std::vector<Lesson> lessons() {
   return {{"multigrid",
            "the hierarchy, iterations, prepare and V-cycle cost; PCG against block Jacobi and IC",
            "meshes/plate_poster.msh", add_multigrid_options,
-           [](const LessonRun& run) { return multigrid_table(run); }}};
+           [](const LessonRun& run) { return multigrid_table(run); }, true}};
 }
 
 }  // namespace fem::ch10
