@@ -75,6 +75,15 @@ std::array<PairOf, 16> pair_of_blocks() {
 }
 const std::array<PairOf, 16> kPairOf = pair_of_blocks();
 
+// total += mine, from every thread once. An integer sum is exact in any order, so the one
+// atomic of the chapter leaves the result independent of the threads. (Not an OpenMP
+// reduction: on an orphaned loop of a variable a lambda captures, Clang 14 refuses it,
+// "reduction variable must be shared", where GCC accepts it.)
+void add_count(long long& total, long long mine) {
+#pragma omp atomic
+  total += mine;
+}
+
 }  // namespace
 
 ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& settings,
@@ -148,11 +157,11 @@ void ThreadsStepper::element_pass_gather(const State& state) {
   const int num_elements = static_cast<int>(model_.tets.size());
   long long fallbacks = 0;
   run_parallel([&] {
-    // Every element on its own: its terms go to its own slots, nothing is shared. (An
-    // integer sum is exact in any order: the one OpenMP reduction of the chapter.)
-#pragma omp for schedule(static) reduction(+ : fallbacks)
+    long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
+    // Every element on its own: its terms go to its own slots, nothing is shared.
+#pragma omp for schedule(static)
     for (int e = 0; e < num_elements; ++e)
-      elements_.terms(e, model_.tets[e], state, fallbacks, element_terms_[e]);
+      elements_.terms(e, model_.tets[e], state, my_fallbacks, element_terms_[e]);
     // Every row sums its terms, in element order: b_i over the corners at node i, each
     // block over the element blocks that land on it.
 #pragma omp for schedule(static)
@@ -176,6 +185,7 @@ void ThreadsStepper::element_pass_gather(const State& state) {
         A_.blocks[k] = sum;
       }
     }
+    add_count(fallbacks, my_fallbacks);
   });
   elements_.end_pass(fallbacks);
 }
@@ -184,19 +194,21 @@ void ThreadsStepper::element_pass_colouring(const State& state) {
   long long fallbacks = 0;
   run_parallel([&] {
     ch08::ElementTerms terms;
+    long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
     for (int colour = 0; colour < colours(); ++colour) {
       // The barrier at the end of each loop orders the colours: no two threads ever add
       // into the same node's blocks at the same time.
-#pragma omp for schedule(static) reduction(+ : fallbacks)
+#pragma omp for schedule(static)
       for (int k = colour_start_[colour]; k < colour_start_[colour + 1]; ++k) {
         const int group = colour_order_[k];
         const int last = std::min(static_cast<int>(model_.tets.size()), (group + 1) * kGroup);
         for (int e = group * kGroup; e < last; ++e) {
-          elements_.terms(e, model_.tets[e], state, fallbacks, terms);
+          elements_.terms(e, model_.tets[e], state, my_fallbacks, terms);
           ch08::scatter(model_.tets[e], index_.element[e], terms, A_, b_);
         }
       }
     }
+    add_count(fallbacks, my_fallbacks);
   });
   elements_.end_pass(fallbacks);
 }
