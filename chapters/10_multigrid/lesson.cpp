@@ -31,17 +31,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+MultigridSettings::Smoother smoother_from(const std::string& name) {
+  if (name == "gs") return MultigridSettings::Smoother::GaussSeidel;
+  if (name == "chebyshev") return MultigridSettings::Smoother::Chebyshev;
+  if (name == "jacobi") return MultigridSettings::Smoother::Jacobi;
+  throw UsageError("--smoother must be gs, chebyshev or jacobi");
+}
+
 MultigridSettings multigrid_from_args(const ArgParser& args) {
   MultigridSettings s;
   s.modes = args.get_int("modes");
-  const std::string smoother = args.get("smoother");
-  if (smoother == "gs")
-    s.smoother = MultigridSettings::Smoother::GaussSeidel;
-  else if (smoother == "jacobi")
-    s.smoother = MultigridSettings::Smoother::Jacobi;
-  else
-    throw UsageError("--smoother must be gs or jacobi");
+  s.smoother = smoother_from(args.get("smoother"));
   s.sweeps = args.get_int("sweeps");
+  s.l1 = args.get("l1") != "off";
+  s.max_blocks = args.get_int("blocks");
+  s.serial_rows = args.get_int("serial-rows");
+  s.chebyshev_degree = args.get_int("degree");
+  s.improve_candidates = args.get_int("improve");
   const std::string prolongator = args.get("prolongator");
   if (prolongator != "every-step" && prolongator != "frozen" && prolongator != "tentative")
     throw UsageError("--prolongator must be frozen, every-step or tentative");
@@ -49,10 +55,15 @@ MultigridSettings multigrid_from_args(const ArgParser& args) {
   s.update_prolongator = prolongator == "every-step";
   s.max_coarse_dofs = args.get_int("max-coarse");
   s.coarse_refresh = args.get_int("coarse-every");
+  s.refresh_growth = args.get_double("growth");
   if (s.coarse_refresh < 1) throw UsageError("--coarse-every must be at least 1");
   if (s.modes != 3 && s.modes != 6) throw UsageError("--modes must be 3 or 6");
   if (s.sweeps < 1) throw UsageError("--sweeps must be at least 1");
   if (s.max_coarse_dofs < 6) throw UsageError("--max-coarse must be at least 6");
+  if (s.max_blocks < 1 || s.chebyshev_degree < 1 || s.improve_candidates < 0 || s.serial_rows < 0)
+    throw UsageError("--blocks and --degree must be at least 1, --improve and --serial-rows 0 or more");
+  if (!(s.refresh_growth >= 0.0)) throw UsageError("--growth must be 0 (off) or more");
+  if (args.get("l1") != "on" && args.get("l1") != "off") throw UsageError("--l1 must be on or off");
   return s;
 }
 
@@ -226,14 +237,24 @@ std::string multigrid_table(const LessonRun& run) {
 void add_multigrid_options(ArgParser& args) {
   add_solver_options(args);
   args.option("modes", "N", "near-null-space modes per aggregate: 6 or 3 (translations)", "6");
-  args.option("smoother", "NAME", "gs (symmetric block Gauss-Seidel) or jacobi", "gs");
+  args.option("smoother", "NAME",
+              "gs (l1-hybrid block Gauss-Seidel), chebyshev (on block Jacobi) or jacobi", "gs");
   args.option("sweeps", "N", "pre- and post-smoothing sweeps", "1");
+  args.option("l1", "on|off", "Gauss-Seidel: the l1 term on the couplings between row blocks", "on");
+  args.option("blocks", "N", "at most N fixed row blocks per level (1: sequential Gauss-Seidel)", "64");
+  args.option("serial-rows", "N", "levels of fewer rows run on one thread", "0");
+  args.option("degree", "N", "Chebyshev: the polynomial's degree", "2");
+  args.option("improve", "N", "symmetric Gauss-Seidel sweeps on the rigid-body modes at set-up", "0");
   args.option("prolongator", "KIND",
               "frozen (smoothed on the first step), every-step (smoothed every step) or "
               "tentative (unsmoothed)",
               "frozen");
   args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns", "200");
   args.option("coarse-every", "K", "recompute the coarse matrices every K-th step", "1");
+  args.option("growth", "G",
+              "and earlier when a solve takes more than G times the V-cycles after the last "
+              "refresh (0: never)",
+              "1.25");
   args.option("export", "DIR", "write the last filtered system as Matrix Market into DIR", "");
 }
 

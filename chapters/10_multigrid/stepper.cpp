@@ -16,17 +16,15 @@ Eigen::VectorXd rest_positions(const Scene& scene) {
 }  // namespace
 
 void VCyclePreconditioner::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
-  // The Galerkin products on one thread; the others wait at the end of the single.
-#pragma omp single
+  // Every thread of the solve's team: the multigrid shares out its own row blocks.
   multigrid_.prepare(A.blocks);
 }
 
 void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
                                  Eigen::VectorXd& s) {
-  // One V-cycle on one thread (the smoother's sweeps are sequential): the others wait at the
-  // end of the single. Filtered on both sides by the PCG, S M S is symmetric positive
-  // definite on the free subspace, as PCG needs.
-#pragma omp single
+  // One V-cycle, on every thread of the team, ending with a barrier: the PCG then reads s on
+  // any row. Filtered on both sides by the PCG, S M S is symmetric positive definite on the
+  // free subspace, as PCG needs.
   multigrid_.apply(r, s);
 }
 
