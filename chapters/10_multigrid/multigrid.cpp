@@ -370,11 +370,13 @@ void multiply(const Level<B>& level, const Eigen::VectorXd& x, Eigen::VectorXd& 
     y.template segment<B>(B * i) = row_product(level, x, A.row_start[i], A.row_start[i + 1]);
 }
 
-// The largest eigenvalue of D^-1 A by power iteration from a fixed start (deterministic),
-// as the Rayleigh quotient x^T A x / x^T D x: from below. Uses the level's b and x as
-// scratch; one thread (at a refresh only).
+// The largest eigenvalue of D^-1 A by power iteration, as the Rayleigh quotient
+// x^T A x / x^T D x: from below. The first time from a fixed random start (deterministic),
+// later from the last estimate's vector, which needs fewer iterations. D^-1 is the smoother's
+// inverse diagonal unless that holds the l1 term. Uses the level's b and x as scratch; one
+// thread (at a refresh only).
 template <int B>
-double spectral_radius(Level<B>& level, int iterations) {
+double spectral_radius(Level<B>& level, int iterations, bool plain_inverse) {
   Eigen::VectorXd &x = level.x, &y = level.b;
   x = level.start;
   double rho = 0.0;
@@ -386,11 +388,16 @@ double spectral_radius(Level<B>& level, int iterations) {
       xDx += xi.dot(level.values[level.diagonal[i]] * xi);
     }
     rho = x.dot(y) / xDx;
-    for (int i = 0; i < level.nodes(); ++i)
-      x.template segment<B>(B * i) =
-          level.values[level.diagonal[i]].inverse() * y.template segment<B>(B * i);
+    for (int i = 0; i < level.nodes(); ++i) {
+      const auto yi = y.template segment<B>(B * i);
+      if (plain_inverse)
+        x.template segment<B>(B * i) = level.inverse_diagonal[i] * yi;
+      else
+        x.template segment<B>(B * i) = level.values[level.diagonal[i]].inverse() * yi;
+    }
     x /= x.norm();
   }
+  level.start = x;
   return rho;
 }
 
@@ -764,14 +771,23 @@ void Multigrid::prepare(const std::vector<Eigen::Matrix3d>& fine_blocks) {
   on_one_thread(true, [&] { prolongators_ready_ = true; });
 }
 
-// One level's numbers: its smoother every time; below, at a refresh only, the transfer and
-// the next level. A small level (serial) and the levels below it run on one thread.
+// One level's numbers and, at a refresh, those of the levels below. A small level (serial)
+// and the levels below it run on one thread.
 template <int B>
 void Multigrid::prepare_level(Level<B>& level, std::size_t next, bool collective) {
   if (collective && level.serial) {
     on_one_thread(true, [&] { prepare_level(level, next, false); });
     return;
   }
+  prepare_own(level, next, collective, refresh_);
+  if (refresh_ && !level.coarsest) prepare_level(coarse_[next], next + 1, collective);
+}
+
+// One level's own part of prepare(): its smoother every time (the coarsest level: its
+// Cholesky factor); at a refresh also the polynomial smoother's weights, the prolongator on
+// the first refresh, and the Galerkin product that makes the next level's matrix.
+template <int B>
+void Multigrid::prepare_own(Level<B>& level, std::size_t next, bool collective, bool refresh) {
   const bool gauss_seidel = settings_.smoother == MultigridSettings::Smoother::GaussSeidel;
   for_parts(level, collective, [&](int first, int last) {
     smoother_diagonal(level, gauss_seidel && settings_.l1, first, last);
@@ -786,22 +802,17 @@ void Multigrid::prepare_level(Level<B>& level, std::size_t next, bool collective
     });
     return;
   }
-  if (!refresh_) return;
-  prepare_transfer(level, next, collective);
-}
-
-// At a refresh: the smoother's weights, the prolongator on the first refresh, the Galerkin
-// product and the next level.
-template <int B>
-void Multigrid::prepare_transfer(Level<B>& level, std::size_t next, bool collective) {
+  if (!refresh) return;
   const bool new_prolongator =
       settings_.smooth_prolongator && (settings_.update_prolongator || !prolongators_ready_);
-  const bool gauss_seidel = settings_.smoother == MultigridSettings::Smoother::GaussSeidel;
   on_one_thread(collective, [&] {
     const bool weights = !gauss_seidel && (settings_.smoother == MultigridSettings::Smoother::Chebyshev ||
                                            settings_.jacobi_weight <= 0.0);
     if (new_prolongator || weights) {
-      const double rho = spectral_radius(level, settings_.power_iterations);
+      // Later estimates start from the last one's vector: a few iterations suffice.
+      const int iterations = prolongators_ready_ ? std::min(3, settings_.power_iterations)
+                                                 : settings_.power_iterations;
+      const double rho = spectral_radius(level, iterations, !(gauss_seidel && settings_.l1));
       level.omega = new_prolongator ? 4.0 / (3.0 * rho) : level.omega;
       level.jacobi_weight = settings_.jacobi_weight > 0.0 ? settings_.jacobi_weight : 1.0 / rho;
       level.lambda_max = 1.1 * rho;  // the Rayleigh quotient is from below
@@ -814,7 +825,6 @@ void Multigrid::prepare_transfer(Level<B>& level, std::size_t next, bool collect
     }
   });
   galerkin_product(level, coarse_[next], collective);
-  prepare_level(coarse_[next], next + 1, collective);
 }
 
 // ---- the V-cycle --------------------------------------------------------------------------
@@ -892,22 +902,17 @@ void Multigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
 
 // ---- for the lesson's costs per level ------------------------------------------------------
 
-void Multigrid::prepare_level_only(int level, bool galerkin) {
-  const bool keep = refresh_;
-  on_one_thread(true, [&] { refresh_ = false; });
-  const auto one = [&](auto& l, std::size_t next) {
-    prepare_level(l, next, true);
-    if (!galerkin || l.coarsest) return;
+void Multigrid::prepare_level_only(int level, bool refresh) {
+  const auto own = [&](auto& l, std::size_t next) {
     if (l.serial)
-      on_one_thread(true, [&] { galerkin_product(l, coarse_[next], false); });
+      on_one_thread(true, [&] { prepare_own(l, next, false, refresh); });
     else
-      galerkin_product(l, coarse_[next], true);
+      prepare_own(l, next, true, refresh);
   };
   if (level == 0)
-    one(fine_, 0);
+    own(fine_, 0);
   else
-    one(coarse_.at(level - 1), level);
-  on_one_thread(true, [&] { refresh_ = keep; });
+    own(coarse_.at(level - 1), level);
 }
 
 void Multigrid::cycle_from(int level) {

@@ -50,7 +50,7 @@ struct MultigridSettings {
   // Modes per aggregate: 6 (3 translations, 3 rotations) or 3 (translations only). The
   // coarse blocks stay 6 x 6; unused modes become identity rows, as constrained dofs do.
   int modes = kModes;
-  Smoother smoother = Smoother::GaussSeidel;
+  Smoother smoother = Smoother::Chebyshev;
   int sweeps = 1;              // pre- and post-smoothing sweeps per level
   bool l1 = true;              // Gauss-Seidel: the l1 term (false: plain hybrid Gauss-Seidel)
   // The fixed row blocks of every level: at most max_blocks blocks of at least block_rows
@@ -70,13 +70,16 @@ struct MultigridSettings {
   int power_iterations = 10;        // estimates of rho(D^-1 A)
   // Sweeps of symmetric Gauss-Seidel on A B = 0 that improve the rigid-body modes B on the
   // first matrix before T is built (PyAMG's improve_candidates); 0: the modes as they are.
-  int improve_candidates = 0;
+  int improve_candidates = 4;
   // The refresh rule for the coarse matrices: recomputed every coarse_refresh-th prepare,
   // and earlier when the last solve took more than refresh_growth times the V-cycles of the
   // solve right after the last refresh (0: never earlier). 1: every step.
-  int coarse_refresh = 1;
+  int coarse_refresh = 10;
   double refresh_growth = 1.25;
   int max_coarse_dofs = 200;  // the dense Cholesky's size limit
+  // Not the hierarchy's but the stepper's: the PCG's guess extrapolated from the last two
+  // solutions, 2 y_n - y_(n-1), instead of the last one.
+  bool extrapolate_guess = true;
   int max_levels = 8;
 };
 
@@ -169,10 +172,10 @@ class Multigrid {
   // Refreshes of the coarse matrices so far, and whether the last prepare() was one.
   long long refreshes() const { return refreshes_; }
   bool refreshed() const { return refreshed_; }
-  // For the lesson's costs per level: prepare()'s work on one level (the smoother's set-up,
-  // and the Galerkin product below it when `galerkin`), and one V-cycle from `level` down.
-  // Same calling rules as prepare() and apply(); the second uses the level's own b.
-  void prepare_level_only(int level, bool galerkin);
+  // For the lesson's costs per level: prepare()'s own work on one level (as at a refresh, or
+  // as between refreshes), and one V-cycle from `level` down on the level's own b. Same
+  // calling rules as prepare() and apply(); after a first prepare().
+  void prepare_level_only(int level, bool refresh);
   void cycle_from(int level);
   // For tests and reports (allocate): level matrices, prolongators from level to level + 1,
   // and the identity diagonal added on the unused modes of level (level >= 1).
@@ -184,7 +187,7 @@ class Multigrid {
   template <int B>
   void prepare_level(Level<B>& level, std::size_t next, bool collective);
   template <int B>
-  void prepare_transfer(Level<B>& level, std::size_t next, bool collective);
+  void prepare_own(Level<B>& level, std::size_t next, bool collective, bool refresh);
   template <int B>
   void cycle(Level<B>& level, std::size_t next, const Eigen::VectorXd& b, Eigen::VectorXd& x,
              bool collective);

@@ -34,8 +34,27 @@ MultigridStepper::MultigridStepper(const Scene& scene, const SolverSettings& set
     : ThreadsStepper(scene, settings, element_parallelism),
       // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
       multigrid_(system_matrix().row_start, system_matrix().column, rest_positions(scene),
-                 scene.constraints, multigrid) {
+                 scene.constraints, multigrid),
+      extrapolate_(multigrid.extrapolate_guess),
+      previous_y_(Eigen::VectorXd::Zero(system_rhs().size())) {
   use_preconditioner(v_cycle_, "10_multigrid");
+}
+
+void MultigridStepper::solve() {
+  // y_ holds the last solution. With two of them, the guess is the line through both,
+  // 2 y_n - y_(n-1): the velocity change of a smooth motion changes smoothly. Element by
+  // element on one thread: 3N multiply-adds, no sum, the same bits for any thread count.
+  if (extrapolate_ && solves_ >= 2) {
+    for (Eigen::Index k = 0; k < y_.size(); ++k) {
+      const double last = y_[k];
+      y_[k] = 2.0 * last - previous_y_[k];
+      previous_y_[k] = last;
+    }
+  } else {
+    previous_y_ = y_;
+  }
+  ++solves_;
+  ThreadsStepper::solve();
 }
 
 }  // namespace fem::ch10
