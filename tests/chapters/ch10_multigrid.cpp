@@ -218,7 +218,7 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
 }
 
-TEST_CASE("ch10: lagged coarse matrices give the same motion; the V-cycle stays SPD",
+TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle",
           "[ch10]") {
   // A lagged V-cycle is still SPD, so PCG reaches the same tolerance: only iterations change.
   const Scene scene = test::driven_scene();
