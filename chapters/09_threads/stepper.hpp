@@ -44,11 +44,12 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // The PCG's preconditioner from the next step on (block Jacobi until then), and the
   // chapter's name in the solver's warnings. The preconditioner must outlive the stepper.
   void use_preconditioner(Preconditioner& preconditioner, const char* chapter);
+  // The parallel PCG on the filtered system from the guess in y_ (chapter 10 extends it).
+  void solve() override;
 
  private:
   void start_system(const State& state) override;
   void element_pass(const State& state) override;
-  void solve() override;
   void build_gather_tables();
   void build_colouring();
   void element_pass_gather(const State& state);

@@ -16,17 +16,15 @@ Eigen::VectorXd rest_positions(const Scene& scene) {
 }  // namespace
 
 void VCyclePreconditioner::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
-  // The Galerkin products on one thread; the others wait at the end of the single.
-#pragma omp single
+  // Every thread of the solve's team: the multigrid shares out its own row blocks.
   multigrid_.prepare(A.blocks);
 }
 
 void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
                                  Eigen::VectorXd& s) {
-  // One V-cycle on one thread (the smoother's sweeps are sequential): the others wait at the
-  // end of the single. Filtered on both sides by the PCG, S M S is symmetric positive
-  // definite on the free subspace, as PCG needs.
-#pragma omp single
+  // One V-cycle, on every thread of the team, ending with a barrier: the PCG then reads s on
+  // any row. Filtered on both sides by the PCG, S M S is symmetric positive definite on the
+  // free subspace, as PCG needs.
   multigrid_.apply(r, s);
 }
 
@@ -36,8 +34,27 @@ MultigridStepper::MultigridStepper(const Scene& scene, const SolverSettings& set
     : ThreadsStepper(scene, settings, element_parallelism),
       // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
       multigrid_(system_matrix().row_start, system_matrix().column, rest_positions(scene),
-                 scene.constraints, multigrid) {
+                 scene.constraints, multigrid),
+      extrapolate_(multigrid.extrapolate_guess),
+      previous_y_(Eigen::VectorXd::Zero(system_rhs().size())) {
   use_preconditioner(v_cycle_, "10_multigrid");
+}
+
+void MultigridStepper::solve() {
+  // y_ holds the last solution. With two of them, the guess is the line through both,
+  // 2 y_n - y_(n-1): the velocity change of a smooth motion changes smoothly. Element by
+  // element on one thread: 3N multiply-adds, no sum, the same bits for any thread count.
+  if (extrapolate_ && solves_ >= 2) {
+    for (Eigen::Index k = 0; k < y_.size(); ++k) {
+      const double last = y_[k];
+      y_[k] = 2.0 * last - previous_y_[k];
+      previous_y_[k] = last;
+    }
+  } else {
+    previous_y_ = y_;
+  }
+  ++solves_;
+  ThreadsStepper::solve();
 }
 
 }  // namespace fem::ch10

@@ -35,8 +35,14 @@ class MultigridStepper final : public ch09::ThreadsStepper {
   Multigrid& multigrid() { return multigrid_; }
 
  private:
+  // Chapter 09's solve from an extrapolated guess (when extrapolate_guess is set).
+  void solve() override;
+
   Multigrid multigrid_;  // set up from the pattern of the system matrix
   VCyclePreconditioner v_cycle_{multigrid_};
+  bool extrapolate_;
+  Eigen::VectorXd previous_y_;  // the solution of the step before the last
+  int solves_ = 0;
 };
 
 }  // namespace fem::ch10

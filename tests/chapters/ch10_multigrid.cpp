@@ -1,8 +1,13 @@
 // Chapter 10: the multigrid preconditioner is what PCG's theory needs (symmetric, positive
-// definite on the filtered space), its coarse matrices are the Galerkin products, it cuts the
-// iterations, the state is the same to the last bit on 1 and 2 threads, and the stepper still
-// matches chapter 01 without allocating.
+// definite on the filtered space, also on lagged coarse levels), its coarse matrices are the
+// Galerkin products right after a refresh, it cuts the iterations, the state is the same to
+// the last bit on 1, 2 and 3 threads with every smoother, the stepper still matches chapter 01
+// without allocating, and a long run under a jumping mouse spring stays bounded while the
+// jumps trigger refreshes.
+#include <random>
+
 #include "catch2_compat.hpp"
+
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/threads.hpp"
@@ -22,38 +27,57 @@ Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
 
 // The test mesh is small (190 nodes): a coarse limit below the default gives it the three
 // levels a poster-sized mesh has, so that every code path of the V-cycle runs.
+// Small row blocks (block_rows 4) give every level several blocks, so that the threads share
+// out the coarse levels too.
 using Smoother = ch10::MultigridSettings::Smoother;
-constexpr Smoother kSmoothers[] = {Smoother::GaussSeidel, Smoother::Jacobi};
+constexpr Smoother kSmoothers[] = {Smoother::Chebyshev, Smoother::GaussSeidel, Smoother::Jacobi};
 
-ch10::MultigridSettings three_levels(Smoother smoother = Smoother::GaussSeidel) {
+ch10::MultigridSettings three_levels(Smoother smoother = ch10::MultigridSettings{}.smoother) {
   ch10::MultigridSettings s;
   s.max_coarse_dofs = 24;
   s.smoother = smoother;
+  s.block_rows = 4;
   return s;
+}
+
+// 1, 2 and 3 threads with OpenMP (3: a count that divides nothing evenly); 1 without.
+std::vector<int> thread_counts() {
+  return openmp_enabled() ? std::vector<int>{1, 2, 3} : std::vector<int>{1};
+}
+
+bool bit_identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.array() == b.array()).all();
 }
 
 }  // namespace
 
 FEM_CHAPTER_TESTS("10", "[ch10]")
 
-TEST_CASE("ch10: bit-identical states after 50 steps with 1 and 2 threads", "[ch10]") {
-  // The V-cycle runs on one thread; everything around it is chapter 09's deterministic
-  // parallel step, so the thread count must not change a bit.
-  const auto run_with = [](const Scene& scene, int threads) {
+TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "[ch10]") {
+  // Every loop of prepare and of the V-cycle goes over fixed row blocks, every sum in a fixed
+  // order, and the refresh rule reads only iteration counts: the thread count must not change
+  // a bit, with the default settings and with every smoother on three levels of small blocks.
+  const auto run_with = [](const Scene& scene, int threads, const ch10::MultigridSettings& s) {
     const ThreadCountScope scope(threads);
-    ch10::MultigridStepper stepper(scene, {});
+    ch10::MultigridStepper stepper(scene, {}, s);
     State state = rest_state(scene);
     for (int k = 0; k < 50; ++k) stepper.step(state);
     return state;
   };
-  for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()}) {
-    const State reference = run_with(scene, 1);
-    REQUIRE((reference.x - rest_state(scene).x).cwiseAbs().maxCoeff() > 1e-3);  // it moves
-    const State state = run_with(scene, openmp_enabled() ? 2 : 1);
-    INFO(scene.name);
-    CHECK((state.x.array() == reference.x.array()).all());
-    CHECK((state.v.array() == reference.v.array()).all());
-  }
+  std::vector<ch10::MultigridSettings> settings = {ch10::MultigridSettings{}};
+  for (const Smoother smoother : kSmoothers) settings.push_back(three_levels(smoother));
+  for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()})
+    for (const auto& s : settings) {
+      const State reference = run_with(scene, 1, s);
+      REQUIRE((reference.x - rest_state(scene).x).cwiseAbs().maxCoeff() > 1e-3);  // it moves
+      for (const int threads : thread_counts()) {
+        const State state = run_with(scene, threads, s);
+        INFO(scene.name << ", smoother " << static_cast<int>(s.smoother) << ", " << threads
+                        << " threads");
+        CHECK(bit_identical(state.x, reference.x));
+        CHECK(bit_identical(state.v, reference.v));
+      }
+    }
 }
 
 TEST_CASE("ch10: the V-cycle is symmetric positive definite on the filtered space", "[ch10]") {
@@ -81,12 +105,21 @@ TEST_CASE("ch10: the V-cycle is symmetric positive definite on the filtered spac
   }
 }
 
-TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen", "[ch10]") {
+TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a refresh",
+          "[ch10]") {
+  // The default refresh rule keeps the coarse matrices for several steps: step until a refresh
+  // past the first one (the prolongator is smoothed on the first), then compare.
   for (const Scene& scene : all_scenes()) {
     ch10::MultigridStepper stepper(scene, {}, three_levels());
     State state = rest_state(scene);
-    for (int k = 0; k < 3; ++k) stepper.step(state);
+    stepper.step(state);
+    int steps = 1;
+    do {
+      stepper.step(state);
+      ++steps;
+    } while (!stepper.multigrid().refreshed() && steps < 100);
     const ch10::Multigrid& mg = stepper.multigrid();
+    REQUIRE(mg.refreshed());
     REQUIRE(mg.levels() == 3);
     // The finest level is the stepper's filtered system itself.
     CHECK((mg.level_matrix(0) - stepper.system_matrix().to_sparse()).norm() == 0.0);
@@ -133,9 +166,11 @@ TEST_CASE("ch10: a mode is unused exactly where its prolongator column is zero",
   }
 }
 
-TEST_CASE("ch10: iterations on the test mesh at most 8, a sixth of the block-Jacobi PCG's",
+TEST_CASE("ch10: iterations on the test mesh at most 9, a fifth of the block-Jacobi PCG's",
           "[ch10]") {
-  // Both at the default tolerance 1e-4 from the same states, side by side for 20 steps.
+  // Both at the default tolerance 1e-4 from the same states, side by side for 20 steps
+  // (chapter 10 with its lagged coarse matrices and extrapolated guess: 9 on the sliding
+  // scene, where the hierarchy has two levels on this small mesh).
   for (const Scene& scene : all_scenes()) {
     ch09::ThreadsStepper jacobi(scene, {});
     ch10::MultigridStepper multigrid(scene, {});
@@ -149,8 +184,8 @@ TEST_CASE("ch10: iterations on the test mesh at most 8, a sixth of the block-Jac
       CHECK(multigrid.profile().converged);
     }
     INFO(scene.name << ": at most " << most << " iterations, block Jacobi " << most_jacobi);
-    CHECK(most <= 8);
-    CHECK(6 * most <= most_jacobi);
+    CHECK(most <= 9);
+    CHECK(5 * most <= most_jacobi);
   }
 }
 
@@ -184,32 +219,126 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
 }
 
-TEST_CASE("ch10: coarse matrices kept for several steps give the same motion", "[ch10]") {
+TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle",
+          "[ch10]") {
   // A lagged V-cycle is still SPD, so PCG reaches the same tolerance: only iterations change.
   const Scene scene = test::driven_scene();
-  ch10::MultigridSettings lagged = three_levels();
-  lagged.coarse_refresh = 3;
-  ch10::MultigridStepper every_step(scene, test::tight_solver(), three_levels());
-  ch10::MultigridStepper every_third(scene, test::tight_solver(), lagged);
+  ch10::MultigridSettings every_step = three_levels(), lagged = three_levels();
+  every_step.coarse_refresh = 1;
+  lagged.coarse_refresh = 5;  // every fifth step only: the rule without its early refresh
+  lagged.refresh_growth = 0.0;
+  ch10::MultigridStepper fresh(scene, test::tight_solver(), every_step);
+  ch10::MultigridStepper stale(scene, test::tight_solver(), lagged);
   State a = rest_state(scene), b = rest_state(scene);
   const Eigen::VectorXd X = a.x;
   double motion = 0.0, difference = 0.0;
   for (int k = 0; k < 20; ++k) {
-    every_step.step(a);
-    every_third.step(b);
-    CHECK(every_third.profile().converged);
+    const Eigen::SparseMatrix<double> coarse = stale.multigrid().level_matrix(1);
+    fresh.step(a);
+    stale.step(b);
+    CHECK(stale.profile().converged);
+    // Between refreshes the coarse matrices are the old ones, to the bit.
+    if (k > 0 && !stale.multigrid().refreshed())
+      CHECK((stale.multigrid().level_matrix(1) - coarse).norm() == 0.0);
     motion = std::max(motion, (a.x - X).cwiseAbs().maxCoeff());
     difference = std::max(difference, (a.x - b.x).cwiseAbs().maxCoeff());
   }
+  CHECK(fresh.multigrid().refreshes() == 20);
+  CHECK(stale.multigrid().refreshes() == 4);  // steps 1, 6, 11 and 16
   INFO("max |dx| " << difference << " of motion " << motion);
   CHECK(difference < 1e-8 * motion);
-  // The last step (the 20th) kept the coarse matrices of the 19th: still SPD.
-  std::srand(11);
-  const Eigen::Index n = X.size();
-  const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
-  Eigen::VectorXd Mx(n), My(n);
-  every_third.multigrid().apply(x, Mx);
-  every_third.multigrid().apply(y, My);
-  CHECK(std::abs(x.dot(My) - y.dot(Mx)) <= 1e-12 * std::sqrt(x.dot(Mx) * y.dot(My)));
-  CHECK(x.dot(Mx) > 0.0);
+  // The last step (the 20th) kept the coarse matrices of the 16th: still SPD.
+  for (const Smoother smoother : kSmoothers) {
+    lagged.smoother = smoother;
+    ch10::MultigridStepper stepper(scene, {}, lagged);
+    State state = rest_state(scene);
+    for (int k = 0; k < 8; ++k) stepper.step(state);
+    REQUIRE(!stepper.multigrid().refreshed());
+    std::srand(11);
+    const Eigen::Index n = X.size();
+    const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
+    Eigen::VectorXd Mx(n), My(n);
+    stepper.multigrid().apply(x, Mx);
+    stepper.multigrid().apply(y, My);
+    INFO("smoother " << static_cast<int>(smoother));
+    CHECK(std::abs(x.dot(My) - y.dot(Mx)) <= 1e-12 * std::sqrt(x.dot(Mx) * y.dot(My)));
+    CHECK(x.dot(Mx) > 0.0);
+    CHECK(y.dot(My) > 0.0);
+  }
+}
+
+namespace {
+
+struct Soak {
+  State state;
+  int most_iterations = 0, not_converged = 0;
+  long long refreshes = 0, jump_refreshes = 0;
+  std::string diverged;
+};
+
+// A few thousand steps with a mouse spring on a random surface node that jumps to another
+// node every 50 steps, pulling towards a random point near the node's rest position (chapter
+// 09's soak, with longer holds so that the lag's steady state shows between the jumps).
+// Counts the refreshes in the 3 steps after each jump.
+Soak soak(const Scene& scene, int threads, int steps) {
+  const ThreadCountScope scope(threads);
+  ch10::MultigridStepper stepper(scene, {});
+  const Model model(scene);
+  std::vector<int> surface;
+  for (const auto& t : scene.mesh.boundary)
+    for (int a = 0; a < 3; ++a) surface.push_back(t[a]);
+  std::sort(surface.begin(), surface.end());
+  surface.erase(std::unique(surface.begin(), surface.end()), surface.end());
+  std::mt19937 random(2026);
+  std::uniform_int_distribution<std::size_t> pick(0, surface.size() - 1);
+  std::uniform_real_distribution<double> offset(-0.15, 0.15);
+  const double stiffness = model.lumped_mass.sum() / 3.0 * 9.81 / 0.05;  // its weight over 5 cm
+  int node = 0;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  Soak out;
+  out.state = rest_state(scene);
+  for (int k = 0; k < steps; ++k) {
+    if (k % 50 == 0) {
+      node = surface[pick(random)];
+      target = scene.mesh.X.col(node) + Eigen::Vector3d(offset(random), offset(random), offset(random));
+    }
+    stepper.set_external_forces({{node, stiffness * (target - out.state.x.segment<3>(3 * node))}});
+    stepper.step(out.state);
+    if (const char* why = divergence(out.state, stepper.profile())) {
+      out.diverged = why;
+      return out;
+    }
+    out.not_converged += stepper.profile().converged ? 0 : 1;
+    out.most_iterations = std::max(out.most_iterations, stepper.profile().cg_iterations);
+    if (k > 0 && k % 50 < 3 && stepper.multigrid().refreshed()) ++out.jump_refreshes;
+  }
+  out.refreshes = stepper.multigrid().refreshes();
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("ch10: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
+          "[ch10][soak]") {
+  const Scene scene = test::test_scene("cantilever");
+  const int steps = 3000;
+  std::vector<Soak> runs;
+  for (const int threads : openmp_enabled() ? std::vector<int>{1, 2} : std::vector<int>{1}) {
+    runs.push_back(soak(scene, threads, steps));
+    const Soak& r = runs.back();
+    INFO(threads << " threads: at most " << r.most_iterations << " iterations, " << r.refreshes
+                 << " refreshes, " << r.jump_refreshes << " right after a jump");
+    CHECK(r.diverged.empty());
+    CHECK(r.not_converged == 0);
+    CHECK(r.most_iterations <= 20);
+    // The rule refreshes every k-th step and when the iterations grow: the jumps trigger
+    // refreshes beyond the periodic ones, most of them within 3 steps of the jump.
+    const int k = ch10::MultigridSettings{}.coarse_refresh;
+    CHECK(r.refreshes > steps / k);
+    CHECK(r.jump_refreshes > steps / 50 / 2);
+  }
+  if (runs.size() == 2) {
+    CHECK(bit_identical(runs[0].state.x, runs[1].state.x));
+    CHECK(bit_identical(runs[0].state.v, runs[1].state.v));
+  }
 }

@@ -32,7 +32,12 @@ TEST_CASE("divergence: a capped solve is a failed step only when worse than no s
   CHECK(divergence(state, solve_that(true, 2.0)) == nullptr);
 }
 
-TEST_CASE("divergence: nu = 0.4999999 fails the first step in every chapter", "[divergence]") {
+// Near incompressibility locks the linear tetrahedra: no chapter's solve converges within the
+// cap. Jacobi-type preconditioners stop with a residual above 1 (worse than dv = 0), which the
+// programs stop on; chapter 10's V-cycle gets below 1 (about 0.5), an unconverged step that
+// the programs report (report_if_not_converged) and keep, as for any solve at its cap.
+TEST_CASE("divergence: nu = 0.4999999 converges in no chapter, a residual above 1 stops the run",
+          "[divergence]") {
   Material nearly_incompressible;
   nearly_incompressible.youngs_modulus = 2e5;
   nearly_incompressible.poisson_ratio = 0.4999999;
@@ -50,6 +55,7 @@ TEST_CASE("divergence: nu = 0.4999999 fails the first step in every chapter", "[
                     << p.relative_residual);
     CHECK_FALSE(p.converged);
     CHECK(state.x.allFinite());  // finite, so only the residual tells
-    CHECK(divergence(state, p) != nullptr);
+    CHECK((divergence(state, p) != nullptr) == (p.relative_residual > 1.0));
+    if (chapter.id < "10") CHECK(p.relative_residual > 1.0);
   }
 }
