@@ -42,8 +42,7 @@ std::string threads_spmv_rows(const Scene& scene, const std::vector<int>& thread
     const double us = 1e3 / products * time_ms(7, [&] {
       ch09::run_parallel([&] {
         for (int k = 0; k < products; ++k) {
-#pragma omp for schedule(static)
-          for (int c = 0; c < chunks.count(); ++c)
+          for (const int c : StaticShare(chunks.count()))
             A.multiply_rows(x, y, chunks.start[c], chunks.start[c + 1]);
         }
       });

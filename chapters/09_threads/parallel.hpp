@@ -26,4 +26,49 @@ void run_parallel(Body&& body) {
   body();
 }
 
+// `#pragma omp for schedule(static)` written out, for `for (const int c : StaticShare(count))`
+// called by every thread of a team: this thread's contiguous block of [0, count), as the
+// static schedule hands them out, and the barrier that ends a worksharing loop, run by the
+// destructor when the loop is over (the range lives as long as the loop). Why not the
+// pragma: Debian's libomp 14 (Clang's OpenMP runtime) mallocs and frees a 512-byte buffer in
+// every __kmpc_for_static_init (seen under gdb: a debug trace string formatted in a release
+// library), so every worksharing loop would allocate and the step would not be allocation-free;
+// GCC's libgomp allocates nothing there. Outside a parallel region (one thread) the block is
+// the whole range and the barrier does nothing.
+class StaticShare {
+ public:
+  explicit StaticShare(int count) : StaticShare(0, count) {}
+  // This thread's block of [first, last).
+  StaticShare(int first, int last) {
+#ifdef _OPENMP
+    const long long threads = omp_get_num_threads(), thread = omp_get_thread_num();
+#else
+    const long long threads = 1, thread = 0;
+#endif
+    const long long count = last - first;
+    begin_ = first + static_cast<int>(count * thread / threads);
+    end_ = first + static_cast<int>(count * (thread + 1) / threads);
+  }
+  ~StaticShare() {
+#pragma omp barrier
+  }
+  StaticShare(const StaticShare&) = delete;
+  StaticShare& operator=(const StaticShare&) = delete;
+
+  struct Iterator {
+    int i;
+    int operator*() const { return i; }
+    Iterator& operator++() {
+      ++i;
+      return *this;
+    }
+    bool operator!=(const Iterator& other) const { return i != other.i; }
+  };
+  Iterator begin() const { return {begin_}; }
+  Iterator end() const { return {end_}; }
+
+ private:
+  int begin_ = 0, end_ = 0;
+};
+
 }  // namespace fem::ch09

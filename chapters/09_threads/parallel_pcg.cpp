@@ -40,8 +40,7 @@ double sum_in_order(const std::vector<double>& partial) {
 void Preconditioner::apply_rows(int, int, const Eigen::VectorXd&, Eigen::VectorXd&) const {}
 
 void Preconditioner::apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks.count(); ++c) apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
+  for (const int c : StaticShare(chunks.count())) apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
 }
 
 BlockJacobi::BlockJacobi(const std::vector<int>& diagonal_block)
@@ -50,8 +49,7 @@ BlockJacobi::BlockJacobi(const std::vector<int>& diagonal_block)
 void BlockJacobi::prepare(const BlockSparseMatrix& A, const RowChunks& chunks) {
   // The diagonal blocks of the filtered matrix are symmetric positive definite (a fixed
   // node's is the identity): a fixed-size 3x3 inverse each.
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks.count(); ++c)
+  for (const int c : StaticShare(chunks.count()))
     for (int i = chunks.start[c]; i < chunks.start[c + 1]; ++i)
       inverse_diagonal_[i] = A.blocks[diagonal_block_[i]].inverse();
 }
@@ -103,8 +101,7 @@ SolveStats ParallelPcg::iterate(const BlockSparseMatrix& A, Preconditioner& M,
                                 const SolverSettings& settings, Eigen::VectorXd& y) {
   SolveStats stats;
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
-#pragma omp for schedule(static)
-    for (int c = 0; c < chunks_.count(); ++c) y.segment(chunks_.first_dof(c), chunks_.dofs(c)).setZero();
+    for (const int c : StaticShare(chunks_.count())) y.segment(chunks_.first_dof(c), chunks_.dofs(c)).setZero();
     stats.converged = true;
     return stats;
   }
@@ -153,8 +150,7 @@ void ParallelPcg::precondition_chunk(const Preconditioner& M, int c, Eigen::Vect
 }
 
 double ParallelPcg::filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y) {
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     filter(c, y);
     partial_bb_[c] = b.segment(chunks_.first_dof(c), chunks_.dofs(c)).squaredNorm();
   }
@@ -163,8 +159,7 @@ double ParallelPcg::filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y) {
 
 double ParallelPcg::residual(const BlockSparseMatrix& A, const Preconditioner& M,
                              const Eigen::VectorXd& b, const Eigen::VectorXd& y) {
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
     A.multiply_rows(y, q_, chunks_.start[c], chunks_.start[c + 1]);
     r_.segment(first, size) = b.segment(first, size) - q_.segment(first, size);
@@ -178,8 +173,7 @@ double ParallelPcg::residual(const BlockSparseMatrix& A, const Preconditioner& M
 double ParallelPcg::precondition(Preconditioner& M, Eigen::VectorXd& s) {
   // M reads r of every row: it starts after the barrier that ended r's update.
   M.apply(chunks_, r_, s);
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     filter(c, s);
     partial_rs_[c] = r_.segment(chunks_.first_dof(c), chunks_.dofs(c))
                          .dot(s.segment(chunks_.first_dof(c), chunks_.dofs(c)));
@@ -189,8 +183,7 @@ double ParallelPcg::precondition(Preconditioner& M, Eigen::VectorXd& s) {
 
 double ParallelPcg::product(const BlockSparseMatrix& A) {
   // q = A p reads p of the neighbouring rows: the barrier that ended p's update comes first.
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     A.multiply_rows(p_, q_, chunks_.start[c], chunks_.start[c + 1]);
     partial_pq_[c] = p_.segment(chunks_.first_dof(c), chunks_.dofs(c))
                          .dot(q_.segment(chunks_.first_dof(c), chunks_.dofs(c)));
@@ -203,8 +196,7 @@ double ParallelPcg::update(const Preconditioner& M, double step, Eigen::VectorXd
   // while it sits in L1: y += step p, r -= step q, r filtered, ||r||^2, and for a
   // block-diagonal M also s = S M r and r . s. Each is an Eigen expression on the chunk's
   // segment, so it keeps the SIMD of the whole-vector operations of the chapters before.
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
     y.segment(first, size) += step * p_.segment(first, size);
     r_.segment(first, size) -= step * q_.segment(first, size);
@@ -216,8 +208,7 @@ double ParallelPcg::update(const Preconditioner& M, double step, Eigen::VectorXd
 }
 
 void ParallelPcg::next_direction(double beta) {
-#pragma omp for schedule(static)
-  for (int c = 0; c < chunks_.count(); ++c) {
+  for (const int c : StaticShare(chunks_.count())) {
     const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
     p_.segment(first, size) = s_.segment(first, size) + beta * p_.segment(first, size);
   }

@@ -137,8 +137,7 @@ void ThreadsStepper::start_system(const State& state) {
   // row by row on the thread that owns the row.
   const double mass_factor = 1.0 + h * alpha;
   run_parallel([&] {
-#pragma omp for schedule(static)
-    for (int c = 0; c < chunks_.count(); ++c) {
+    for (const int c : StaticShare(chunks_.count())) {
       for (int k = A_.row_start[chunks_.start[c]]; k < A_.row_start[chunks_.start[c + 1]]; ++k)
         A_.blocks[k].setZero();
       for (int i = chunks_.start[c]; i < chunks_.start[c + 1]; ++i)
@@ -159,13 +158,11 @@ void ThreadsStepper::element_pass_gather(const State& state) {
   run_parallel([&] {
     long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
     // Every element on its own: its terms go to its own slots, nothing is shared.
-#pragma omp for schedule(static)
-    for (int e = 0; e < num_elements; ++e)
+    for (const int e : StaticShare(num_elements))
       elements_.terms(e, model_.tets[e], state, my_fallbacks, element_terms_[e]);
     // Every row sums its terms, in element order: b_i over the corners at node i, each
     // block over the element blocks that land on it.
-#pragma omp for schedule(static)
-    for (int c = 0; c < chunks_.count(); ++c) {
+    for (const int c : StaticShare(chunks_.count())) {
       for (int i = chunks_.start[c]; i < chunks_.start[c + 1]; ++i) {
         Eigen::Vector3d sum = b_.segment<3>(3 * i);
         for (int k = node_corner_start_[i]; k < node_corner_start_[i + 1]; ++k)
@@ -198,8 +195,7 @@ void ThreadsStepper::element_pass_colouring(const State& state) {
     for (int colour = 0; colour < colours(); ++colour) {
       // The barrier at the end of each loop orders the colours: no two threads ever add
       // into the same node's blocks at the same time.
-#pragma omp for schedule(static)
-      for (int k = colour_start_[colour]; k < colour_start_[colour + 1]; ++k) {
+      for (const int k : StaticShare(colour_start_[colour], colour_start_[colour + 1])) {
         const int group = colour_order_[k];
         const int last = std::min(static_cast<int>(model_.tets.size()), (group + 1) * kGroup);
         for (int e = group * kGroup; e < last; ++e) {

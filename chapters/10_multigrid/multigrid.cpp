@@ -15,6 +15,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "chapters/09_threads/parallel.hpp"
+
 namespace fem::ch10 {
 
 namespace {
@@ -315,8 +317,7 @@ template <int B, class Body>
 void for_parts(const Level<B>& level, bool collective, Body&& body) {
   const int count = level.parts();
   if (collective) {
-#pragma omp for schedule(static)
-    for (int p = 0; p < count; ++p) body(level.part[p], level.part[p + 1]);
+    for (const int p : ch09::StaticShare(count)) body(level.part[p], level.part[p + 1]);
   } else {
     for (int p = 0; p < count; ++p) body(level.part[p], level.part[p + 1]);
   }
