@@ -74,12 +74,13 @@ struct MultigridSettings {
   // The refresh rule for the coarse matrices: recomputed every coarse_refresh-th prepare,
   // and earlier when the last solve took more than refresh_growth times the V-cycles of the
   // solve right after the last refresh (0: never earlier). 1: every step.
-  int coarse_refresh = 10;
+  int coarse_refresh = 20;
   double refresh_growth = 1.25;
   int max_coarse_dofs = 200;  // the dense Cholesky's size limit
-  // Not the hierarchy's but the stepper's: the PCG's guess extrapolated from the last two
-  // solutions, 2 y_n - y_(n-1), instead of the last one.
-  bool extrapolate_guess = true;
+  // Not the hierarchy's but the stepper's: the PCG's guess, the polynomial through the last
+  // extrapolation + 1 solutions one step ahead (0: the last solution, chapter 09's warm start;
+  // 1: 2 y_n - y_(n-1); 2: 3 y_n - 3 y_(n-1) + y_(n-2)).
+  int extrapolation = 2;
   int max_levels = 8;
 };
 

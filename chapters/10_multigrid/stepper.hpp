@@ -35,13 +35,13 @@ class MultigridStepper final : public ch09::ThreadsStepper {
   Multigrid& multigrid() { return multigrid_; }
 
  private:
-  // Chapter 09's solve from an extrapolated guess (when extrapolate_guess is set).
+  // Chapter 09's solve from a guess extrapolated from the last solutions.
   void solve() override;
 
   Multigrid multigrid_;  // set up from the pattern of the system matrix
   VCyclePreconditioner v_cycle_{multigrid_};
-  bool extrapolate_;
-  Eigen::VectorXd previous_y_;  // the solution of the step before the last
+  int extrapolation_;            // the guess's order: 0, 1 or 2
+  Eigen::VectorXd history_[2];  // the solutions of the two steps before the last
   int solves_ = 0;
 };
 
