@@ -31,6 +31,7 @@ class AdaptiveTeam {
   void set_enabled(bool enabled) { enabled_ = enabled; }
   bool enabled() const { return enabled_; }
   int switches() const { return switches_; }
+  int team() const { return team_; }  // of the last step
 
  private:
   static constexpr int kWindow = 3, kFirstPeriod = 8, kMaxPeriod = 256;
