@@ -143,8 +143,8 @@ Costs measure_costs(Multigrid& mg, const Eigen::VectorXd& b, int threads, long l
   c.threads = threads;
   Eigen::VectorXd y(b.size());
   for (int l = 0; l < mg.levels(); ++l) {
-    LevelCost cost;
-    cost.between = team_ms(5, [&] { mg.prepare_level_only(l, false); });
+    LevelCost cost;  // between refreshes prepare() touches the finest level only
+    if (l == 0) cost.between = team_ms(5, [&] { mg.prepare_level_only(l, false); });
     cost.refresh = team_ms(5, [&] { mg.prepare_level_only(l, true); });
     cost.cycle_from = team_ms(20, [&] { mg.cycle_from(l); });
     c.level.push_back(cost);
@@ -180,7 +180,9 @@ std::string cost_table(const Multigrid& mg, const std::vector<Costs>& costs, dou
   for (int l = 0; l < mg.levels(); ++l) {
     const std::string level = "level " + std::to_string(l) + " (" +
                               std::to_string(mg.level_parts(l)) + " row blocks): ";
-    row(level + "`prepare` between refreshes", [&](const Costs& c) { return ms_spmv(c.level[l].between, spmv); });
+    if (l == 0)
+      row(level + "`prepare` between refreshes",
+          [&](const Costs& c) { return ms_spmv(c.level[l].between, spmv); });
     row(level + "`prepare` at a refresh", [&](const Costs& c) { return ms_spmv(c.level[l].refresh, spmv); });
     row(level + "its share of one V-cycle", [&](const Costs& c) {
       const double below = l + 1 < mg.levels() ? c.level[l + 1].cycle_from : 0.0;

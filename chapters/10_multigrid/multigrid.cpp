@@ -221,6 +221,7 @@ void build_prolongator_pattern(Level<B>& fine, int count, bool smooth) {
   fine.PT = BlockCsr<kModes, B>(transposed);
   fine.pt_block.clear();
   for (const auto& s : source) fine.pt_block.insert(fine.pt_block.end(), s.begin(), s.end());
+  fine.p_transposed.resize(fine.pt_block.size());
 }
 
 // A P on the pattern of A times P's, stored whole (each row written by its owner), and the
@@ -238,6 +239,8 @@ void build_ap_pattern(Level<B>& fine) {
     sort_unique(rows[i]);
   }
   fine.AP = BlockCsr<B, kModes>(rows);
+  fine.AP.blocks.clear();  // the values are stored transposed, in apt
+  fine.apt.resize(fine.AP.column.size());
   fine.ap_target.clear();
   fine.ap_first.resize(n + 1);
   for (int i = 0; i < n; ++i) {
@@ -344,6 +347,19 @@ EIGEN_ALWAYS_INLINE void add_product(Eigen::Matrix<double, R, 1>& acc,
   for (int j = 0; j < C; ++j) acc += M.col(j) * x[j];
 }
 
+// out += L M^T for small fixed-size blocks, column by column: each column of out is a sum of
+// L's columns, vectors of R = 6 rows in the Galerkin products (3-row columns vectorize poorly).
+template <int R, int K, int C>
+EIGEN_ALWAYS_INLINE void add_product_transposed(Eigen::Matrix<double, R, C>& out,
+                                                const Eigen::Matrix<double, R, K>& L,
+                                                const Eigen::Matrix<double, C, K>& M) {
+  for (int c = 0; c < C; ++c) {
+    Eigen::Matrix<double, R, 1> sum = out.col(c);
+    for (int t = 0; t < K; ++t) sum += L.col(t) * M(c, t);
+    out.col(c) = sum;
+  }
+}
+
 // sum of A_k x_(column k) over the blocks [begin, end) of a row, in two independent sums: the
 // products of a row then overlap instead of waiting on each other's additions.
 template <int B>
@@ -422,30 +438,35 @@ void smooth_prolongator(Level<B>& level) {
   }
 }
 
-// P^T's blocks from P's, in P^T's row order: the restriction and the Galerkin product then
-// stream through them as an SpMV does. After every change of P (set-up, smoothing).
+// P^T's blocks from P's, in P^T's row order (the restriction and the Galerkin product then
+// stream through them as an SpMV does) and in P's (for A P, row by row). After every change
+// of P (set-up, smoothing).
 template <int B>
 void transpose_prolongator(Level<B>& level) {
   for (std::size_t e = 0; e < level.pt_block.size(); ++e)
     level.PT.blocks[e] = level.P.blocks[level.pt_block[e]].transpose();
+  for (std::size_t m = 0; m < level.P.blocks.size(); ++m)
+    level.p_transposed[m] = level.P.blocks[m].transpose();
 }
 
 // A_c = P^T (A P) on the fixed patterns, by the team: A P by fine rows, each row by the
 // thread that owns it; then the blocks on and right of the diagonal of A_c by the owner of
 // each coarse row, summed over P^T's row in increasing fine row, the same order for any
-// thread count; then the rest by symmetry (after the barrier: another row's blocks).
+// thread count; then the rest by symmetry (after the barrier: another row's blocks). A P is
+// stored transposed, (A P)^T = P^T A (A symmetric), so that both products work on 6-row
+// columns: (A P)_q^T += P_m^T A_k^T, then A_c += P^T_e ((A P)_q^T)^T.
 template <int B>
 void galerkin_product(Level<B>& level, Level<kModes>& coarse, bool collective) {
   const auto& A = level.A;
   const auto& P = level.P;
-  auto& AP = level.AP;
+  const auto& AP = level.AP;
   for_parts(level, collective, [&](int first, int last) {
-    for (int q = AP.row_start[first]; q < AP.row_start[last]; ++q) AP.blocks[q].setZero();
+    for (int q = AP.row_start[first]; q < AP.row_start[last]; ++q) level.apt[q].setZero();
     const int* target = level.ap_target.data() + level.ap_first[first];
     for (int k = A.row_start[first]; k < A.row_start[last]; ++k) {
       const int j = A.column[k];
       for (int m = P.row_start[j]; m < P.row_start[j + 1]; ++m)
-        AP.blocks[*target++].noalias() += level.values[k] * P.blocks[m];
+        add_product_transposed(level.apt[*target++], level.p_transposed[m], level.values[k]);
     }
   });
   auto& Ac = coarse.A;
@@ -456,7 +477,7 @@ void galerkin_product(Level<B>& level, Level<kModes>& coarse, bool collective) {
       for (int e = level.PT.row_start[c]; e < level.PT.row_start[c + 1]; ++e) {
         const int i = level.PT.column[e];
         for (int q = level.galerkin_first[level.pt_block[e]]; q < AP.row_start[i + 1]; ++q)
-          Ac.blocks[*target++].noalias() += level.PT.blocks[e] * AP.blocks[q];
+          add_product_transposed(Ac.blocks[*target++], level.PT.blocks[e], level.apt[q]);
       }
       // Modes an aggregate lacks: a zero row and column, given the identity (I - S).
       Ac.blocks[coarse.diagonal[c]].diagonal() += coarse.unused[c];

@@ -120,9 +120,11 @@ struct Level {
   // and the Galerkin product, by the owner of each coarse row).
   BlockCsr<kModes, B> PT;
   std::vector<int> pt_block;
-  // A P on its pattern, every row: row i is computed by the owner of fine row i; per product
-  // A_k P_m (row by row, in loop order), where it lands in AP.blocks.
+  std::vector<Eigen::Matrix<double, kModes, B>> p_transposed;  // per block m of P: P_m^T
+  // A P on its pattern (its values transposed in apt), every row: row i is computed by the
+  // owner of fine row i; per product A_k P_m (row by row, in loop order), where it lands.
   BlockCsr<B, kModes> AP;
+  std::vector<Eigen::Matrix<double, kModes, B>> apt;
   std::vector<int> ap_target;
   std::vector<int> ap_first;  // per row: its first product's index into ap_target
   // A_c is symmetric: only its blocks (c, d) with d >= c are computed, by the owner of row c.
