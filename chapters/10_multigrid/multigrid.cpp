@@ -762,18 +762,25 @@ void Multigrid::improve_candidates() {
 // ---- every step ---------------------------------------------------------------------------
 
 // The refresh rule, on one thread between barriers: it reads only V-cycle counts, the same
-// for any thread count, so the decision (and the state) is too.
+// for any thread count, so the decision (and the state) is too. Its yardstick is the count of
+// the solve right after a refresh; after the first refresh, of the second solve, since the
+// first one starts cold (no guess from earlier steps).
 void Multigrid::decide_refresh() {
   const int last = cycles_;
   cycles_ = 0;
-  if (refreshed_) cycles_after_refresh_ = last;  // the solve right after the last refresh
+  ++prepares_;
+  if (measure_next_ && prepares_ > 2) {
+    cycles_after_refresh_ = last;
+    measure_next_ = false;
+  }
   ++since_refresh_;
-  const bool grown = settings_.refresh_growth > 0.0 &&
+  const bool grown = settings_.refresh_growth > 0.0 && !measure_next_ &&
                      last > settings_.refresh_growth * cycles_after_refresh_;
   refresh_ = !prolongators_ready_ || since_refresh_ >= settings_.coarse_refresh || grown;
   if (refresh_) {
     since_refresh_ = 0;
     ++refreshes_;
+    measure_next_ = true;
   }
   refreshed_ = refresh_;
 }

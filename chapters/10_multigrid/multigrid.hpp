@@ -208,9 +208,11 @@ class Multigrid {
   // The refresh rule's state, written by one thread between barriers.
   bool refresh_ = true, refreshed_ = false;
   long long refreshes_ = 0;
-  int since_refresh_ = 0;       // prepares since the last refresh
-  int cycles_ = 0;              // V-cycles since the last prepare (the last solve's)
+  long long prepares_ = 0;
+  int since_refresh_ = 0;         // prepares since the last refresh
+  int cycles_ = 0;                // V-cycles since the last prepare (the last solve's)
   int cycles_after_refresh_ = 0;  // V-cycles of the solve right after the last refresh
+  bool measure_next_ = false;     // the next prepare reads the yardstick
 };
 
 }  // namespace fem::ch10
