@@ -62,7 +62,7 @@ struct MultigridSettings {
   // A level with fewer rows than this runs (with all levels below it) on one thread: there a
   // barrier costs more than the work it shares out.
   int serial_rows = 0;
-  int chebyshev_degree = 2;        // Chebyshev: SpMVs per smoothing
+  int chebyshev_degree = 3;        // Chebyshev: SpMVs per smoothing
   double chebyshev_ratio = 30.0;   // smooths the eigenvalues in [lambda_max / ratio, lambda_max]
   double jacobi_weight = 0.0;      // Jacobi smoother: 0 means 1 / rho(D^-1 A)
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
