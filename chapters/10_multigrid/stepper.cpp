@@ -1,7 +1,8 @@
 // Chapter 10: chapter 09's step, A dv = b filtered by PPCG and solved by the parallel PCG,
-// with one change: the preconditioner. Block Jacobi becomes one V-cycle of smoothed-
-// aggregation multigrid, set up once from the mesh (the constructor), its numbers refreshed
-// every solve (prepare), applied once per PCG iteration (apply).
+// with two changes: the preconditioner, and the guess. Block Jacobi becomes one V-cycle of
+// smoothed-aggregation multigrid, set up once from the mesh (the constructor), its finest
+// level refreshed every solve and its coarse levels every few (prepare), applied once per
+// PCG iteration (apply); the guess is the polynomial through the last solutions.
 #include "chapters/10_multigrid/stepper.hpp"
 
 #include <algorithm>

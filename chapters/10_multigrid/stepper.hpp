@@ -2,8 +2,9 @@
 // element pass, the block SpMV over fixed row chunks, sums in chunk order) with one V-cycle
 // of smoothed-aggregation multigrid (multigrid.hpp) as the PCG's preconditioner in place of
 // block Jacobi: the preconditioner Tamstorf, Jones & McCormick 2015 pair with their PPCG.
-// The V-cycle runs on one thread, so the result is still the same to the last bit for any
-// thread count.
+// The V-cycle runs on every thread of the PCG's team over fixed row blocks, with sums in a
+// fixed order, so the result is still the same to the last bit for any thread count; the
+// guess is extrapolated from the last solutions.
 #pragma once
 
 #include "chapters/09_threads/parallel_pcg.hpp"
