@@ -299,7 +299,7 @@ lessons() {
   for lesson in noalias dfdx-fill compose spmv rotations threads-element; do
     "$BUILD_DIR/fem_lessons" "$lesson" --json "docs/data/lessons/$lesson.json" >/dev/null
   done
-  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --json docs/data/lessons/multigrid.json >/dev/null
+  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --cost-threads 1,2 --json docs/data/lessons/multigrid.json >/dev/null
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   "$VENV/bin/python" scripts/lesson_tables.py

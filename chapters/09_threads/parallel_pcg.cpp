@@ -1,5 +1,5 @@
-// Chapter 09's parallel PCG: one parallel region per solve, one `omp for` over the fixed
-// chunks per step of the iteration, sums in chunk order.
+// Chapter 09's parallel PCG: one parallel region per solve, one shared loop (StaticShare)
+// over the fixed chunks per step of the iteration, sums in chunk order.
 #include "chapters/09_threads/parallel_pcg.hpp"
 
 #include <Eigen/LU>

@@ -12,9 +12,12 @@
 #include "chapters/09_threads/stepper.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <numeric>
 
 #include "chapters/09_threads/parallel.hpp"
+#include "common/threads.hpp"
 
 namespace fem::ch09 {
 
@@ -97,6 +100,23 @@ ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& setting
     build_gather_tables();
   else
     build_colouring();
+  const char* adaptive = std::getenv("FEM_ADAPTIVE_TEAM");
+  adaptive_team_.set_enabled(!(adaptive && std::strcmp(adaptive, "0") == 0));
+}
+
+void ThreadsStepper::step(State& state) {
+  // The program's count is OpenMP's (--threads, OMP_NUM_THREADS); a step on another team sets
+  // it for this thread's regions during the step and puts it back.
+  const int given = max_threads();
+  // libgomp mallocs a thread's ICV block at its first omp_set_num_threads (gomp_icv in
+  // libgomp's icv.c; measured: one allocation, once): make it in the first step, which the
+  // zero-allocation rule leaves out, not in the first step that switches the team.
+  if (!steps_taken_++) set_threads(given);
+  const int team = adaptive_team_.next(given);
+  if (team != given) set_threads(team);
+  ElementKernelsStepper::step(state);
+  if (team != given) set_threads(given);
+  adaptive_team_.record(profile_.step.seconds);
 }
 
 void ThreadsStepper::use_preconditioner(Preconditioner& preconditioner, const char* chapter) {

@@ -12,6 +12,7 @@
 #include "chapters/07_block_sparse/block_sparse.hpp"
 #include "chapters/08_element_kernels/element_kernels.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
+#include "chapters/09_threads/adaptive_team.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
 #include "common/model.hpp"
 #include "common/stepper.hpp"
@@ -37,8 +38,14 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
                  ElementParallelism element_parallelism = ElementParallelism::colouring);
   ThreadsStepper(const ThreadsStepper&) = delete;  // preconditioner_ points into *this
   ThreadsStepper& operator=(const ThreadsStepper&) = delete;
+  // Chapter 08's step on the team that AdaptiveTeam picks: the program's thread count, or one
+  // thread while that is faster (a busy machine). The state is the same either way.
+  void step(State& state) override;
   bool uses_threads() const override { return true; }
   int colours() const { return static_cast<int>(colour_start_.size()) - 1; }
+  // Tests that compare thread counts keep the count they set (off); the environment variable
+  // FEM_ADAPTIVE_TEAM=0 turns it off for a whole program (to see what it prevents).
+  AdaptiveTeam& adaptive_team() { return adaptive_team_; }
 
  protected:
   // The PCG's preconditioner from the next step on (block Jacobi until then), and the
@@ -68,6 +75,8 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   static constexpr int kGroup = 16;
   std::vector<int> colour_order_, colour_start_;
   ParallelPcg parallel_pcg_;
+  AdaptiveTeam adaptive_team_;
+  long long steps_taken_ = 0;
   BlockJacobi block_jacobi_;
   Preconditioner* preconditioner_ = &block_jacobi_;
 };

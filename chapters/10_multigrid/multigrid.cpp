@@ -3,8 +3,8 @@
 // tables and every level's fixed row blocks. Every step (prepare): the finest level's
 // smoother; at a refresh also P = (I - w D^-1 A) T (the first time), A_c = P^T A P, the
 // coarse smoothers and the coarsest Cholesky, numbers only. Every PCG iteration (apply): one
-// V-cycle. prepare and apply run on the whole team: every loop an `omp for` over fixed row
-// blocks, each row written by one thread, every sum in a fixed order.
+// V-cycle. prepare and apply run on the whole team: every loop a StaticShare (chapter 09's
+// `omp for` written out) over fixed row blocks, each row written by one thread, every sum in a fixed order.
 #include "chapters/10_multigrid/multigrid.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -223,6 +223,7 @@ void build_prolongator_pattern(Level<B>& fine, int count, bool smooth) {
   fine.PT = BlockCsr<kModes, B>(transposed);
   fine.pt_block.clear();
   for (const auto& s : source) fine.pt_block.insert(fine.pt_block.end(), s.begin(), s.end());
+  fine.p_transposed.resize(fine.pt_block.size());
 }
 
 // A P on the pattern of A times P's, stored whole (each row written by its owner), and the
@@ -240,6 +241,8 @@ void build_ap_pattern(Level<B>& fine) {
     sort_unique(rows[i]);
   }
   fine.AP = BlockCsr<B, kModes>(rows);
+  fine.AP.blocks.clear();  // the values are stored transposed, in apt
+  fine.apt.resize(fine.AP.column.size());
   fine.ap_target.clear();
   fine.ap_first.resize(n + 1);
   for (int i = 0; i < n; ++i) {
@@ -311,8 +314,8 @@ void finish_coarsest(Level<B>& level) {
 // ---- the team's loops ---------------------------------------------------------------------
 
 // body(first, last) on each of the level's fixed row blocks: shared out between the threads
-// of the team by an orphaned `omp for` (a static schedule, a barrier at its end) when
-// collective, all on this thread otherwise (inside a `single`, where no `omp for` may nest).
+// of the team by a StaticShare (a static schedule, a barrier at its end: parallel.hpp) when
+// collective, all on this thread otherwise (inside a `single`, where no loop may be shared).
 template <int B, class Body>
 void for_parts(const Level<B>& level, bool collective, Body&& body) {
   const int count = level.parts();
@@ -343,6 +346,19 @@ template <int R, int C>
 EIGEN_ALWAYS_INLINE void add_product(Eigen::Matrix<double, R, 1>& acc,
                                      const Eigen::Matrix<double, R, C>& M, const double* x) {
   for (int j = 0; j < C; ++j) acc += M.col(j) * x[j];
+}
+
+// out += L M^T for small fixed-size blocks, column by column: each column of out is a sum of
+// L's columns, vectors of R = 6 rows in the Galerkin products (3-row columns vectorize poorly).
+template <int R, int K, int C>
+EIGEN_ALWAYS_INLINE void add_product_transposed(Eigen::Matrix<double, R, C>& out,
+                                                const Eigen::Matrix<double, R, K>& L,
+                                                const Eigen::Matrix<double, C, K>& M) {
+  for (int c = 0; c < C; ++c) {
+    Eigen::Matrix<double, R, 1> sum = out.col(c);
+    for (int t = 0; t < K; ++t) sum += L.col(t) * M(c, t);
+    out.col(c) = sum;
+  }
 }
 
 // sum of A_k x_(column k) over the blocks [begin, end) of a row, in two independent sums: the
@@ -423,30 +439,35 @@ void smooth_prolongator(Level<B>& level) {
   }
 }
 
-// P^T's blocks from P's, in P^T's row order: the restriction and the Galerkin product then
-// stream through them as an SpMV does. After every change of P (set-up, smoothing).
+// P^T's blocks from P's, in P^T's row order (the restriction and the Galerkin product then
+// stream through them as an SpMV does) and in P's (for A P, row by row). After every change
+// of P (set-up, smoothing).
 template <int B>
 void transpose_prolongator(Level<B>& level) {
   for (std::size_t e = 0; e < level.pt_block.size(); ++e)
     level.PT.blocks[e] = level.P.blocks[level.pt_block[e]].transpose();
+  for (std::size_t m = 0; m < level.P.blocks.size(); ++m)
+    level.p_transposed[m] = level.P.blocks[m].transpose();
 }
 
 // A_c = P^T (A P) on the fixed patterns, by the team: A P by fine rows, each row by the
 // thread that owns it; then the blocks on and right of the diagonal of A_c by the owner of
 // each coarse row, summed over P^T's row in increasing fine row, the same order for any
-// thread count; then the rest by symmetry (after the barrier: another row's blocks).
+// thread count; then the rest by symmetry (after the barrier: another row's blocks). A P is
+// stored transposed, (A P)^T = P^T A (A symmetric), so that both products work on 6-row
+// columns: (A P)_q^T += P_m^T A_k^T, then A_c += P^T_e ((A P)_q^T)^T.
 template <int B>
 void galerkin_product(Level<B>& level, Level<kModes>& coarse, bool collective) {
   const auto& A = level.A;
   const auto& P = level.P;
-  auto& AP = level.AP;
+  const auto& AP = level.AP;
   for_parts(level, collective, [&](int first, int last) {
-    for (int q = AP.row_start[first]; q < AP.row_start[last]; ++q) AP.blocks[q].setZero();
+    for (int q = AP.row_start[first]; q < AP.row_start[last]; ++q) level.apt[q].setZero();
     const int* target = level.ap_target.data() + level.ap_first[first];
     for (int k = A.row_start[first]; k < A.row_start[last]; ++k) {
       const int j = A.column[k];
       for (int m = P.row_start[j]; m < P.row_start[j + 1]; ++m)
-        AP.blocks[*target++].noalias() += level.values[k] * P.blocks[m];
+        add_product_transposed(level.apt[*target++], level.p_transposed[m], level.values[k]);
     }
   });
   auto& Ac = coarse.A;
@@ -457,7 +478,7 @@ void galerkin_product(Level<B>& level, Level<kModes>& coarse, bool collective) {
       for (int e = level.PT.row_start[c]; e < level.PT.row_start[c + 1]; ++e) {
         const int i = level.PT.column[e];
         for (int q = level.galerkin_first[level.pt_block[e]]; q < AP.row_start[i + 1]; ++q)
-          Ac.blocks[*target++].noalias() += level.PT.blocks[e] * AP.blocks[q];
+          add_product_transposed(Ac.blocks[*target++], level.PT.blocks[e], level.apt[q]);
       }
       // Modes an aggregate lacks: a zero row and column, given the identity (I - S).
       Ac.blocks[coarse.diagonal[c]].diagonal() += coarse.unused[c];
@@ -742,18 +763,25 @@ void Multigrid::improve_candidates() {
 // ---- every step ---------------------------------------------------------------------------
 
 // The refresh rule, on one thread between barriers: it reads only V-cycle counts, the same
-// for any thread count, so the decision (and the state) is too.
+// for any thread count, so the decision (and the state) is too. Its yardstick is the count of
+// the solve right after a refresh; after the first refresh, of the second solve, since the
+// first one starts cold (no guess from earlier steps).
 void Multigrid::decide_refresh() {
   const int last = cycles_;
   cycles_ = 0;
-  if (refreshed_) cycles_after_refresh_ = last;  // the solve right after the last refresh
+  ++prepares_;
+  if (measure_next_ && prepares_ > 2) {
+    cycles_after_refresh_ = last;
+    measure_next_ = false;
+  }
   ++since_refresh_;
-  const bool grown = settings_.refresh_growth > 0.0 &&
+  const bool grown = settings_.refresh_growth > 0.0 && !measure_next_ &&
                      last > settings_.refresh_growth * cycles_after_refresh_;
   refresh_ = !prolongators_ready_ || since_refresh_ >= settings_.coarse_refresh || grown;
   if (refresh_) {
     since_refresh_ = 0;
     ++refreshes_;
+    measure_next_ = true;
   }
   refreshed_ = refresh_;
 }

@@ -9,8 +9,8 @@
 // once, in the constructor. prepare(A) then recomputes only numbers on those fixed patterns,
 // and apply(r, z) is one V-cycle. Neither allocates.
 //
-// Both run on every thread of the caller's OpenMP team: every loop is an orphaned `omp for`
-// over the level's fixed row blocks, every sum runs in a fixed order, so the result is the
+// Both run on every thread of the caller's OpenMP team: every loop is shared out like an
+// orphaned `omp for` (chapter 09's StaticShare) over the level's fixed row blocks, every sum runs in a fixed order, so the result is the
 // same to the last bit for any thread count. Called outside a parallel region, they run on
 // the calling thread alone.
 //
@@ -62,7 +62,7 @@ struct MultigridSettings {
   // A level with fewer rows than this runs (with all levels below it) on one thread: there a
   // barrier costs more than the work it shares out.
   int serial_rows = 0;
-  int chebyshev_degree = 2;        // Chebyshev: SpMVs per smoothing
+  int chebyshev_degree = 3;        // Chebyshev: SpMVs per smoothing
   double chebyshev_ratio = 30.0;   // smooths the eigenvalues in [lambda_max / ratio, lambda_max]
   double jacobi_weight = 0.0;      // Jacobi smoother: 0 means 1 / rho(D^-1 A)
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
@@ -74,12 +74,13 @@ struct MultigridSettings {
   // The refresh rule for the coarse matrices: recomputed every coarse_refresh-th prepare,
   // and earlier when the last solve took more than refresh_growth times the V-cycles of the
   // solve right after the last refresh (0: never earlier). 1: every step.
-  int coarse_refresh = 10;
+  int coarse_refresh = 20;
   double refresh_growth = 1.25;
   int max_coarse_dofs = 200;  // the dense Cholesky's size limit
-  // Not the hierarchy's but the stepper's: the PCG's guess extrapolated from the last two
-  // solutions, 2 y_n - y_(n-1), instead of the last one.
-  bool extrapolate_guess = true;
+  // Not the hierarchy's but the stepper's: the PCG's guess, the polynomial through the last
+  // extrapolation + 1 solutions one step ahead (0: the last solution, chapter 09's warm start;
+  // 1: 2 y_n - y_(n-1); 2: 3 y_n - 3 y_(n-1) + y_(n-2)).
+  int extrapolation = 2;
   int max_levels = 8;
 };
 
@@ -119,9 +120,11 @@ struct Level {
   // and the Galerkin product, by the owner of each coarse row).
   BlockCsr<kModes, B> PT;
   std::vector<int> pt_block;
-  // A P on its pattern, every row: row i is computed by the owner of fine row i; per product
-  // A_k P_m (row by row, in loop order), where it lands in AP.blocks.
+  std::vector<Eigen::Matrix<double, kModes, B>> p_transposed;  // per block m of P: P_m^T
+  // A P on its pattern (its values transposed in apt), every row: row i is computed by the
+  // owner of fine row i; per product A_k P_m (row by row, in loop order), where it lands.
   BlockCsr<B, kModes> AP;
+  std::vector<Eigen::Matrix<double, kModes, B>> apt;
   std::vector<int> ap_target;
   std::vector<int> ap_first;  // per row: its first product's index into ap_target
   // A_c is symmetric: only its blocks (c, d) with d >= c are computed, by the owner of row c.
@@ -205,9 +208,11 @@ class Multigrid {
   // The refresh rule's state, written by one thread between barriers.
   bool refresh_ = true, refreshed_ = false;
   long long refreshes_ = 0;
-  int since_refresh_ = 0;       // prepares since the last refresh
-  int cycles_ = 0;              // V-cycles since the last prepare (the last solve's)
+  long long prepares_ = 0;
+  int since_refresh_ = 0;         // prepares since the last refresh
+  int cycles_ = 0;                // V-cycles since the last prepare (the last solve's)
   int cycles_after_refresh_ = 0;  // V-cycles of the solve right after the last refresh
+  bool measure_next_ = false;     // the next prepare reads the yardstick
 };
 
 }  // namespace fem::ch10

@@ -2,8 +2,9 @@
 // element pass, the block SpMV over fixed row chunks, sums in chunk order) with one V-cycle
 // of smoothed-aggregation multigrid (multigrid.hpp) as the PCG's preconditioner in place of
 // block Jacobi: the preconditioner Tamstorf, Jones & McCormick 2015 pair with their PPCG.
-// The V-cycle runs on every thread over fixed row blocks with sums in a fixed order, so the
-// result is still the same to the last bit for any thread count.
+// The V-cycle runs on every thread of the PCG's team over fixed row blocks, with sums in a
+// fixed order, so the result is still the same to the last bit for any thread count; the
+// guess is extrapolated from the last solutions.
 #pragma once
 
 #include "chapters/09_threads/parallel_pcg.hpp"
@@ -35,13 +36,13 @@ class MultigridStepper final : public ch09::ThreadsStepper {
   Multigrid& multigrid() { return multigrid_; }
 
  private:
-  // Chapter 09's solve from an extrapolated guess (when extrapolate_guess is set).
+  // Chapter 09's solve from a guess extrapolated from the last solutions.
   void solve() override;
 
   Multigrid multigrid_;  // set up from the pattern of the system matrix
   VCyclePreconditioner v_cycle_{multigrid_};
-  bool extrapolate_;
-  Eigen::VectorXd previous_y_;  // the solution of the step before the last
+  int extrapolation_;            // the guess's order: 0, 1 or 2
+  Eigen::VectorXd history_[2];  // the solutions of the two steps before the last
   int solves_ = 0;
 };
 

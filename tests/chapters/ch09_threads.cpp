@@ -22,6 +22,7 @@ std::vector<int> thread_counts() {
 State run_with(const Scene& scene, int threads, int steps, ch09::ElementParallelism how) {
   const ThreadCountScope scope(threads);
   ch09::ThreadsStepper stepper(scene, {}, how);
+  stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
   State state = rest_state(scene);
   for (int k = 0; k < steps; ++k) stepper.step(state);
   return state;
@@ -122,6 +123,35 @@ TEST_CASE("ch09: one thread opens no parallel region, so it allocates nothing ei
   // per phase would cost a malloc each. run_parallel calls the body directly instead.
   const ThreadCountScope scope(1);
   CHECK(test::allocations_per_step("09", test::driven_scene()) == 0);
+}
+
+TEST_CASE("ch09: the adaptive team switches to one thread when that is faster, and back",
+          "[ch09]") {
+  // Synthetic step times: the team's choice depends on nothing else.
+  const auto run = [](ch09::AdaptiveTeam& team, int steps, double two, double one) {
+    int on_one = 0;
+    for (int k = 0; k < steps; ++k) {
+      const int n = team.next(2);
+      on_one += n == 1;
+      team.record(n == 1 ? one : two);
+    }
+    return on_one;
+  };
+  ch09::AdaptiveTeam team;
+  // Two threads twice as fast: one probe step on one thread now and then, fewer and fewer.
+  CHECK(run(team, 1000, 1.0, 2.0) <= 8);  // probes after 8, 16, 32, ..., 256, 256 steps
+  CHECK(team.switches() == 0);
+  // A busy machine: two threads five times slower. The usual time jumps, the next step probes
+  // one thread and switches; then a probe on two threads now and then.
+  CHECK(run(team, 1000, 5.0, 1.0) >= 985);
+  CHECK(team.switches() == 1);
+  // The machine free again: the next periodic probe on two threads switches back.
+  CHECK(run(team, 1000, 1.0, 2.0) <= 270);
+  CHECK(team.switches() == 2);
+  ch09::AdaptiveTeam off;
+  off.set_enabled(false);
+  CHECK(run(off, 100, 5.0, 1.0) == 0);
+  CHECK(off.next(1) == 1);
 }
 
 TEST_CASE("ch09: --threads style errors: a count below 1 is refused", "[ch09]") {

@@ -60,6 +60,7 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
   const auto run_with = [](const Scene& scene, int threads, const ch10::MultigridSettings& s) {
     const ThreadCountScope scope(threads);
     ch10::MultigridStepper stepper(scene, {}, s);
+    stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
     State state = rest_state(scene);
     for (int k = 0; k < 50; ++k) stepper.step(state);
     return state;
@@ -166,11 +167,9 @@ TEST_CASE("ch10: a mode is unused exactly where its prolongator column is zero",
   }
 }
 
-TEST_CASE("ch10: iterations on the test mesh at most 9, a fifth of the block-Jacobi PCG's",
+TEST_CASE("ch10: iterations on the test mesh at most 8, a sixth of the block-Jacobi PCG's",
           "[ch10]") {
-  // Both at the default tolerance 1e-4 from the same states, side by side for 20 steps
-  // (chapter 10 with its lagged coarse matrices and extrapolated guess: 9 on the sliding
-  // scene, where the hierarchy has two levels on this small mesh).
+  // Both at the default tolerance 1e-4 from the same states, side by side for 20 steps.
   for (const Scene& scene : all_scenes()) {
     ch09::ThreadsStepper jacobi(scene, {});
     ch10::MultigridStepper multigrid(scene, {});
@@ -184,8 +183,8 @@ TEST_CASE("ch10: iterations on the test mesh at most 9, a fifth of the block-Jac
       CHECK(multigrid.profile().converged);
     }
     INFO(scene.name << ": at most " << most << " iterations, block Jacobi " << most_jacobi);
-    CHECK(most <= 9);
-    CHECK(5 * most <= most_jacobi);
+    CHECK(most <= 8);
+    CHECK(6 * most <= most_jacobi);
   }
 }
 
@@ -283,6 +282,7 @@ struct Soak {
 Soak soak(const Scene& scene, int threads, int steps) {
   const ThreadCountScope scope(threads);
   ch10::MultigridStepper stepper(scene, {});
+  stepper.adaptive_team().set_enabled(false);
   const Model model(scene);
   std::vector<int> surface;
   for (const auto& t : scene.mesh.boundary)
@@ -330,7 +330,7 @@ TEST_CASE("ch10: soak, thousands of steps under a jumping mouse spring, 1 and 2 
                  << " refreshes, " << r.jump_refreshes << " right after a jump");
     CHECK(r.diverged.empty());
     CHECK(r.not_converged == 0);
-    CHECK(r.most_iterations <= 20);
+    CHECK(r.most_iterations <= 16);
     // The rule refreshes every k-th step and when the iterations grow: the jumps trigger
     // refreshes beyond the periodic ones, most of them within 3 steps of the jump.
     const int k = ch10::MultigridSettings{}.coarse_refresh;
