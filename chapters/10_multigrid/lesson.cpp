@@ -51,6 +51,8 @@ MultigridSettings multigrid_from_args(const ArgParser& args) {
   s.serial_rows = args.get_int("serial-rows");
   s.chebyshev_degree = args.get_int("degree");
   s.improve_candidates = args.get_int("improve");
+  s.power_iterations = args.get_int("power");
+  if (s.power_iterations < 1) throw UsageError("--power must be at least 1");
   const std::string prolongator = args.get("prolongator");
   if (prolongator != "every-step" && prolongator != "frozen" && prolongator != "tentative")
     throw UsageError("--prolongator must be frozen, every-step or tentative");
@@ -395,6 +397,8 @@ void add_multigrid_options(ArgParser& args) {
               text(d.max_blocks));
   args.option("serial-rows", "N", "levels of fewer rows run on one thread", text(d.serial_rows));
   args.option("degree", "N", "Chebyshev: the polynomial's degree", text(d.chebyshev_degree));
+  args.option("power", "N", "power iterations of the first estimate of rho(D^-1 A) on each level",
+              text(d.power_iterations));
   args.option("improve", "N", "symmetric Gauss-Seidel sweeps on the rigid-body modes at set-up",
               text(d.improve_candidates));
   args.option("extrapolate", "ORDER",

@@ -67,7 +67,7 @@ struct MultigridSettings {
   double jacobi_weight = 0.0;      // Jacobi smoother: 0 means 1 / rho(D^-1 A)
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
   bool update_prolongator = false;  // smooth P at every refresh (default: on the first)
-  int power_iterations = 10;        // estimates of rho(D^-1 A)
+  int power_iterations = 30;        // the first estimate of rho(D^-1 A) (see README: 10 was too few)
   // Sweeps of symmetric Gauss-Seidel on A B = 0 that improve the rigid-body modes B on the
   // first matrix before T is built (PyAMG's improve_candidates); 0: the modes as they are.
   int improve_candidates = 4;
