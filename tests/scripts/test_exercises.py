@@ -41,7 +41,7 @@ def check(name, condition, detail=""):
 EXERCISES = [
     {"id": "01/2", "chapter": "01", "name": "ex_setzero",
      "change": [("dfdx_.coeffs().setZero();", "dfdx_.setZero();")],
-     "bench": "build/release/fem_bench --chapters 01,01_NAME --steps 5 --no-solvers --no-json",
+     "bench": "build/release/fem_bench --chapters 01,01_NAME --steps 5 --warmup 1 --no-solvers --no-json",
      "expect": "more allocations",
      "test": "./tutorial.sh test -L ch01_NAME", "test_passes": True},
     {"id": "02/1", "chapter": "02", "name": "ex_alias",
