@@ -237,3 +237,48 @@ inline void check_drift_at_default_tolerance(const std::string& chapter) {
   TEST_CASE("ch" ID ": drift from chapter 01 at the default tolerance stays bounded", TAG) {  \
     fem::test::check_drift_at_default_tolerance(ID);                                          \
   }
+
+#include <random>
+
+#include "common/model.hpp"
+
+namespace fem::test {
+
+// The mouse of the soak tests: a spring on a random surface node, pulling towards a random
+// point near the node's rest position, that jumps to another node every `hold` steps. Stiff
+// enough to pull the body around (its weight over 5 cm). The same seed gives every chapter
+// the same sequence of nodes and targets.
+class JumpingMouse {
+ public:
+  JumpingMouse(const Scene& scene, int hold) : X_(scene.mesh.X), hold_(hold) {
+    for (const auto& t : scene.mesh.boundary)
+      for (int a = 0; a < 3; ++a) surface_.push_back(t[a]);
+    std::sort(surface_.begin(), surface_.end());
+    surface_.erase(std::unique(surface_.begin(), surface_.end()), surface_.end());
+    stiffness_ = Model(scene).lumped_mass.sum() / 3.0 * 9.81 / 0.05;
+    pick_ = std::uniform_int_distribution<std::size_t>(0, surface_.size() - 1);
+  }
+  // The spring's force on the state before step k (a new node and target when k % hold == 0).
+  std::vector<ExternalForce> force(int k, const State& state) {
+    if (k % hold_ == 0) {
+      node_ = surface_[pick_(random_)];
+      target_ = X_.col(node_) + Eigen::Vector3d(offset_(random_), offset_(random_), offset_(random_));
+    }
+    return {{node_, stiffness_ * (target_ - state.x.segment<3>(3 * node_))}};
+  }
+  // Step k is one of the first `steps` steps after a jump.
+  bool just_jumped(int k, int steps) const { return k > 0 && k % hold_ < steps; }
+
+ private:
+  Eigen::Matrix3Xd X_;
+  int hold_;
+  std::vector<int> surface_;
+  double stiffness_ = 0.0;
+  std::mt19937 random_{2026};
+  std::uniform_int_distribution<std::size_t> pick_;
+  std::uniform_real_distribution<double> offset_{-0.15, 0.15};
+  int node_ = 0;
+  Eigen::Vector3d target_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace fem::test

@@ -1,7 +1,6 @@
 // Chapter 09: the same answer, to the last bit, for any thread count; the same physics as
 // chapter 01; no allocation per step with threads; and a long run under a random mouse
 // spring for every chapter from 07 on.
-#include <random>
 
 #include "catch2_compat.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
@@ -175,35 +174,17 @@ struct SoakResult {
   std::string diverged;
 };
 
-// A few thousand steps with a mouse spring on a random surface node that jumps to another
-// node every few steps, pulling towards a random point near the node's rest position. The
-// same seed gives every chapter the same sequence of nodes and targets.
+// A few thousand steps under the jumping mouse spring (support.hpp), a new node every 7 steps.
 SoakResult soak(const std::string& chapter, const Scene& scene, int threads, int steps) {
   const ThreadCountScope scope(threads);
   auto stepper = make_stepper(chapter, scene, {});
   const Model model(scene);
-  std::vector<int> surface;
-  for (const auto& t : scene.mesh.boundary)
-    for (int a = 0; a < 3; ++a) surface.push_back(t[a]);
-  std::sort(surface.begin(), surface.end());
-  surface.erase(std::unique(surface.begin(), surface.end()), surface.end());
-  std::mt19937 random(2026);
-  std::uniform_int_distribution<std::size_t> pick(0, surface.size() - 1);
-  std::uniform_real_distribution<double> offset(-0.15, 0.15);
-  // Stiff enough to pull the body around: its weight over 5 cm.
-  const double stiffness = model.lumped_mass.sum() / 3.0 * 9.81 / 0.05;
-  int node = 0;
-  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  test::JumpingMouse mouse(scene, 7);
   SoakResult out;
   out.state = rest_state(scene);
   const double rest_energy = total_energy(model, scene, out.state);
   for (int k = 0; k < steps; ++k) {
-    if (k % 7 == 0) {
-      node = surface[pick(random)];
-      target = scene.mesh.X.col(node) + Eigen::Vector3d(offset(random), offset(random), offset(random));
-    }
-    stepper->set_external_forces(
-        {{node, stiffness * (target - out.state.x.segment<3>(3 * node))}});
+    stepper->set_external_forces(mouse.force(k, out.state));
     stepper->step(out.state);
     if (const char* why = divergence(out.state, stepper->profile())) {
       out.diverged = why;

@@ -275,34 +275,18 @@ struct Soak {
   std::string diverged;
 };
 
-// A few thousand steps with a mouse spring on a random surface node that jumps to another
-// node every 50 steps, pulling towards a random point near the node's rest position (chapter
-// 09's soak, with longer holds so that the lag's steady state shows between the jumps).
+// A few thousand steps under the jumping mouse spring (support.hpp), a new node every 50 steps
+// (chapter 09's soak holds 7: longer holds, so that the lag's steady state shows between jumps).
 // Counts the refreshes in the 3 steps after each jump.
 Soak soak(const Scene& scene, int threads, int steps) {
   const ThreadCountScope scope(threads);
   ch10::MultigridStepper stepper(scene, {});
   stepper.adaptive_team().set_enabled(false);
-  const Model model(scene);
-  std::vector<int> surface;
-  for (const auto& t : scene.mesh.boundary)
-    for (int a = 0; a < 3; ++a) surface.push_back(t[a]);
-  std::sort(surface.begin(), surface.end());
-  surface.erase(std::unique(surface.begin(), surface.end()), surface.end());
-  std::mt19937 random(2026);
-  std::uniform_int_distribution<std::size_t> pick(0, surface.size() - 1);
-  std::uniform_real_distribution<double> offset(-0.15, 0.15);
-  const double stiffness = model.lumped_mass.sum() / 3.0 * 9.81 / 0.05;  // its weight over 5 cm
-  int node = 0;
-  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  test::JumpingMouse mouse(scene, 50);
   Soak out;
   out.state = rest_state(scene);
   for (int k = 0; k < steps; ++k) {
-    if (k % 50 == 0) {
-      node = surface[pick(random)];
-      target = scene.mesh.X.col(node) + Eigen::Vector3d(offset(random), offset(random), offset(random));
-    }
-    stepper.set_external_forces({{node, stiffness * (target - out.state.x.segment<3>(3 * node))}});
+    stepper.set_external_forces(mouse.force(k, out.state));
     stepper.step(out.state);
     if (const char* why = divergence(out.state, stepper.profile())) {
       out.diverged = why;
@@ -310,7 +294,7 @@ Soak soak(const Scene& scene, int threads, int steps) {
     }
     out.not_converged += stepper.profile().converged ? 0 : 1;
     out.most_iterations = std::max(out.most_iterations, stepper.profile().cg_iterations);
-    if (k > 0 && k % 50 < 3 && stepper.multigrid().refreshed()) ++out.jump_refreshes;
+    if (mouse.just_jumped(k, 3) && stepper.multigrid().refreshed()) ++out.jump_refreshes;
   }
   out.refreshes = stepper.multigrid().refreshes();
   return out;
