@@ -99,7 +99,7 @@ ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& setting
   if (element_parallelism_ == ElementParallelism::gather)
     build_gather_tables();
   else
-    build_colouring();
+    colour_element_groups(kGroup);
   const char* adaptive = std::getenv("FEM_ADAPTIVE_TEAM");
   adaptive_team_.set_enabled(!(adaptive && std::strcmp(adaptive, "0") == 0));
 }
@@ -135,10 +135,11 @@ void ThreadsStepper::build_gather_tables() {
          [this](int t) { return index_.element[t / 16][t % 16]; }, block_term_start_, block_terms_);
 }
 
-void ThreadsStepper::build_colouring() {
-  // Groups of kGroup consecutive elements rather than single elements: a group keeps the
-  // mesh order's locality (its elements share nodes, hence cache lines).
-  const std::vector<int> colour = colour_groups(model_.tets, model_.num_nodes, kGroup);
+void ThreadsStepper::colour_element_groups(int group) {
+  // Groups of consecutive elements rather than single elements: a group keeps the mesh
+  // order's locality (its elements share nodes, hence cache lines).
+  group_ = std::max(1, group);
+  const std::vector<int> colour = colour_groups(model_.tets, model_.num_nodes, group_);
   const int colours = colour.empty() ? 0 : 1 + *std::max_element(colour.begin(), colour.end());
   invert(colours, static_cast<int>(colour.size()), [&colour](int g) { return colour[g]; },
          colour_start_, colour_order_);
@@ -217,8 +218,8 @@ void ThreadsStepper::element_pass_colouring(const State& state) {
       // into the same node's blocks at the same time.
       for (const int k : StaticShare(colour_start_[colour], colour_start_[colour + 1])) {
         const int group = colour_order_[k];
-        const int last = std::min(static_cast<int>(model_.tets.size()), (group + 1) * kGroup);
-        for (int e = group * kGroup; e < last; ++e) {
+        const int last = std::min(static_cast<int>(model_.tets.size()), (group + 1) * group_);
+        for (int e = group * group_; e < last; ++e) {
           elements_.terms(e, model_.tets[e], state, my_fallbacks, terms);
           ch08::scatter(model_.tets[e], index_.element[e], terms, A_, b_);
         }

@@ -53,12 +53,14 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   void use_preconditioner(Preconditioner& preconditioner, const char* chapter);
   // The parallel PCG on the filtered system from the guess in y_ (chapter 10 extends it).
   void solve() override;
+  // Colours groups of `group` consecutive elements (kGroup by default); chapter 11, whose
+  // elements come sorted along the mesh, makes the groups long slabs.
+  void colour_element_groups(int group);
 
  private:
   void start_system(const State& state) override;
   void element_pass(const State& state) override;
   void build_gather_tables();
-  void build_colouring();
   void element_pass_gather(const State& state);
   void element_pass_colouring(const State& state);
 
@@ -73,6 +75,7 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // Colouring: groups of kGroup consecutive elements, sorted by colour; colour c holds the
   // groups colour_order_[colour_start_[c]] .. colour_order_[colour_start_[c + 1] - 1].
   static constexpr int kGroup = 16;
+  int group_ = kGroup;
   std::vector<int> colour_order_, colour_start_;
   ParallelPcg parallel_pcg_;
   AdaptiveTeam adaptive_team_;

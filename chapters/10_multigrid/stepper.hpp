@@ -26,7 +26,8 @@ class VCyclePreconditioner final : public ch09::Preconditioner {
   Multigrid& multigrid_;
 };
 
-class MultigridStepper final : public ch09::ThreadsStepper {
+// Not final: chapter 11 runs this step on a renumbered mesh.
+class MultigridStepper : public ch09::ThreadsStepper {
  public:
   MultigridStepper(const Scene& scene, const SolverSettings& settings,
                    const MultigridSettings& multigrid = {},
