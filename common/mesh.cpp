@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <unordered_map>
 
 namespace fem {
@@ -129,12 +130,19 @@ TetMesh load_mesh(const std::string& path) {
   gmsh::clear();
   if (node_tags.empty()) fail(path, "not a mesh: gmsh found no nodes in it");
 
+  // Node i is the node with the i-th smallest tag: the file's numbering, also when gmsh lists
+  // the nodes entity by entity in another order (a mesh renumbered by computeRenumbering,
+  // chapter 11). A mesh gmsh generated lists them in tag order already.
+  std::vector<std::size_t> by_tag(node_tags.size());
+  std::iota(by_tag.begin(), by_tag.end(), std::size_t{0});
+  std::sort(by_tag.begin(), by_tag.end(), [&](std::size_t a, std::size_t b) { return node_tags[a] < node_tags[b]; });
   std::unordered_map<std::size_t, int> index_of_tag;
   index_of_tag.reserve(node_tags.size());
   Eigen::Matrix3Xd X(3, static_cast<Eigen::Index>(node_tags.size()));
-  for (std::size_t i = 0; i < node_tags.size(); ++i) {
-    index_of_tag.emplace(node_tags[i], static_cast<int>(i));
-    X.col(static_cast<Eigen::Index>(i)) << coords[3 * i], coords[3 * i + 1], coords[3 * i + 2];
+  for (std::size_t i = 0; i < by_tag.size(); ++i) {
+    const std::size_t k = by_tag[i];
+    index_of_tag.emplace(node_tags[k], static_cast<int>(i));
+    X.col(static_cast<Eigen::Index>(i)) << coords[3 * k], coords[3 * k + 1], coords[3 * k + 2];
   }
   std::vector<Eigen::Vector4i> tets(elem_tags.size());
   for (std::size_t e = 0; e < elem_tags.size(); ++e) {

@@ -10,14 +10,16 @@ namespace fem::ch11 {
 
 Ordering ordering_from_name(const std::string& name) {
   if (name == "original") return Ordering::original;
+  if (name == "file") return Ordering::file;
   if (name == "rcm") return Ordering::rcm;
   if (name == "morton") return Ordering::morton;
-  throw std::invalid_argument("node order '" + name + "': original, rcm or morton");
+  throw std::invalid_argument("node order '" + name + "': original, file, rcm or morton");
 }
 
 std::string ordering_name(Ordering ordering) {
   switch (ordering) {
     case Ordering::original: return "original";
+    case Ordering::file: return "file";
     case Ordering::rcm: return "rcm";
     case Ordering::morton: return "morton";
   }
@@ -162,13 +164,14 @@ NodeOrder node_order(const TetMesh& mesh, Ordering ordering) {
 
 namespace {
 
-TetMesh renumbered_mesh(const TetMesh& mesh, const NodeOrder& order) {
+TetMesh renumbered_mesh(const TetMesh& mesh, const NodeOrder& order, bool sort_elements) {
   TetMesh out = mesh;
   for (int k = 0; k < mesh.num_nodes(); ++k) out.X.col(k) = mesh.X.col(order.old_of_new[k]);
   for (auto& t : out.tets)
     for (int a = 0; a < 4; ++a) t[a] = order.new_of_old[t[a]];
   for (auto& f : out.boundary)
     for (int a = 0; a < 3; ++a) f[a] = order.new_of_old[f[a]];
+  if (!sort_elements) return out;
   // Elements by their smallest node, then the next: the pass walks the nodes forwards.
   std::stable_sort(out.tets.begin(), out.tets.end(), [](const Eigen::Vector4i& a, const Eigen::Vector4i& b) {
     std::array<int, 4> ka = {a[0], a[1], a[2], a[3]}, kb = {b[0], b[1], b[2], b[3]};
@@ -181,12 +184,12 @@ TetMesh renumbered_mesh(const TetMesh& mesh, const NodeOrder& order) {
 
 }  // namespace
 
-Scene renumbered(const Scene& scene, const NodeOrder& order) {
+Scene renumbered(const Scene& scene, const NodeOrder& order, bool sort_elements) {
   if (order.old_of_new.size() != static_cast<std::size_t>(scene.mesh.num_nodes()))
     throw std::invalid_argument("node order: not an order of this mesh's nodes");
-  if (order.identity()) return scene;
+  if (order.identity() && !sort_elements) return scene;
   Scene out = scene;
-  out.mesh = renumbered_mesh(scene.mesh, order);
+  out.mesh = renumbered_mesh(scene.mesh, order, sort_elements);
   for (auto& c : out.constraints) c.node = order.new_of_old[c.node];
   std::stable_sort(out.constraints.begin(), out.constraints.end(),
                    [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });

@@ -30,6 +30,8 @@ namespace fem::ch11 {
 
 enum class Ordering {
   original,  // the mesh file's numbering, elements in the file's order (chapter 10's run)
+  file,      // the mesh file's numbering, elements sorted along it (a file renumbered by
+             // gmsh's computeRenumbering: scripts/renumber_meshes.py)
   rcm,       // reverse Cuthill-McKee
   morton,    // Z-order curve on the rest positions
 };
@@ -50,10 +52,11 @@ std::vector<int> morton_order(const Eigen::Matrix3Xd& X);
 NodeOrder node_order(const TetMesh& mesh, Ordering ordering);
 
 // The scene with node k renamed order.new_of_old[k] everywhere (positions, elements, boundary
-// triangles, constraints, forces), and the elements sorted by their smallest new node, so
-// that the element pass visits the nodes in order too. Each element keeps its own corner
-// order, so its orientation (det Dm > 0) is kept. The identity order changes nothing.
-Scene renumbered(const Scene& scene, const NodeOrder& order);
+// triangles, constraints, forces), and the elements sorted by their smallest new node (then
+// the next ones), so that the element pass visits the nodes in order too. Each element keeps
+// its own corner order, so its orientation (det Dm > 0) is kept. The identity order without
+// sorting changes nothing.
+Scene renumbered(const Scene& scene, const NodeOrder& order, bool sort_elements = true);
 
 // How far apart the numbers of coupled nodes are: the measures the order is meant to shrink.
 struct OrderQuality {

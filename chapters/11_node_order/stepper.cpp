@@ -7,13 +7,15 @@ namespace fem::ch11 {
 
 NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
                                    Ordering ordering, const ch10::MultigridSettings& multigrid)
-    : NodeOrderStepper(scene, settings, node_order(scene.mesh, ordering), multigrid) {}
+    : NodeOrderStepper(scene, settings, ordering, node_order(scene.mesh, ordering), multigrid) {}
 
 // The order is computed once by the public constructor and passed here, so that chapter 10's
 // stepper is built on the renumbered scene before this class's members exist.
 NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
-                                   NodeOrder order, const ch10::MultigridSettings& multigrid)
-    : MultigridStepper(renumbered(scene, order), settings, multigrid),
+                                   Ordering ordering, NodeOrder order,
+                                   const ch10::MultigridSettings& multigrid)
+    : MultigridStepper(renumbered(scene, order, ordering != Ordering::original), settings, multigrid),
+      ordering_(ordering),
       order_(std::move(order)),
       inner_(rest_state(scene_)),
       caller_f_ext_(f_ext_.size()) {
@@ -24,7 +26,7 @@ NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& set
   // consecutive elements form a slab: 64 slabs need a handful of colours (the plate: 5), and
   // the pass walks A about once. (The slabs depend on the mesh only, so the state stays the
   // same for any thread count; the test ch11_node_order.cpp counts the colours.)
-  if (!order_.identity()) colour_element_groups(std::max(16, scene_.mesh.num_tets() / kSlabs));
+  if (ordering_ != Ordering::original) colour_element_groups(std::max(16, scene_.mesh.num_tets() / kSlabs));
 }
 
 void NodeOrderStepper::step(State& state) {

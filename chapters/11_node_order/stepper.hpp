@@ -23,12 +23,14 @@ class NodeOrderStepper : public ch10::MultigridStepper {
   const Eigen::SparseVector<double>& external_forces() const override { return caller_f_ext_; }
 
   const NodeOrder& order() const { return order_; }
+  Ordering ordering() const { return ordering_; }
 
  private:
-  NodeOrderStepper(const Scene& scene, const SolverSettings& settings, NodeOrder order,
-                   const ch10::MultigridSettings& multigrid);
+  NodeOrderStepper(const Scene& scene, const SolverSettings& settings, Ordering ordering,
+                   NodeOrder order, const ch10::MultigridSettings& multigrid);
 
   static constexpr int kSlabs = 64;  // element groups of the parallel pass (stepper.cpp)
+  Ordering ordering_;
   NodeOrder order_;
   State inner_;  // the state in the new numbering, kept so that a step allocates nothing
   std::vector<ExternalForce> renamed_forces_;

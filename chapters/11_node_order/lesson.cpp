@@ -1,0 +1,136 @@
+// Chapter 11's lesson table: `fem_lessons node-order` (see lesson.hpp).
+#include "chapters/11_node_order/lesson.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "chapters/11_node_order/stepper.hpp"
+#include "common/cli.hpp"
+#include "common/lesson.hpp"
+
+namespace fem::ch11 {
+
+namespace {
+
+struct Run {
+  std::string name;  // the order, as the table names it
+  Scene scene;       // in the numbering of its mesh file
+  Ordering ordering;
+  std::unique_ptr<NodeOrderStepper> stepper;
+  State state;
+  std::vector<double> element_ms, iterations;
+};
+
+// The chapter's own orders on the scene, and gmsh's where scripts/renumber_meshes.py wrote a
+// copy of the mesh beside the generated meshes (meshes/generated/NAME_rcmk.msh, ...).
+std::vector<Run> runs_for(const LessonRun& run) {
+  std::vector<Run> runs;
+  for (const Ordering o : {Ordering::original, Ordering::rcm, Ordering::morton})
+    runs.push_back({ordering_name(o), run.scene, o, nullptr, {}, {}, {}});
+  const std::filesystem::path file(run.scene.mesh.file);
+  for (const char* method : {"rcmk", "hilbert", "metis"}) {
+    const auto copy = file.parent_path().parent_path() / "meshes" / "generated" /
+                      (file.stem().string() + "_" + method + ".msh");
+    const auto beside = file.parent_path() / (file.stem().string() + "_" + method + ".msh");
+    for (const auto& path : {copy, beside}) {
+      if (!std::filesystem::exists(path)) continue;
+      Scene scene = make_scene(run.scene.name, load_mesh(path.string()), run.scene.material);
+      scene.dt = run.scene.dt;
+      scene.damping = run.scene.damping;
+      runs.push_back({std::string("gmsh ") + method, std::move(scene), Ordering::file, nullptr, {}, {}, {}});
+      break;
+    }
+  }
+  return runs;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
+}
+
+// One row: the order's measures of memory distance, and its times (1 thread, medians).
+std::string row(Run& r) {
+  const OrderQuality q = order_quality(renumbered(r.scene, r.stepper->order(), false).mesh);
+  const auto& A = r.stepper->system_matrix();
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(3 * A.block_rows()), y(x.size());
+  const double spmv = time_ms(50, [&] { A.multiply(x, y); }, 2.0);
+  const Eigen::VectorXd rhs = r.stepper->system_rhs();
+  Eigen::VectorXd s(rhs.size());
+  const double v_cycle = time_ms(20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
+  const int n = r.scene.mesh.num_nodes();
+  std::ostringstream out;
+  out << "| " << r.name << " | " << q.bandwidth << " | " << fixed(q.profile / n, 0) << " | "
+      << fixed(q.element_spread, 0) << " | " << r.stepper->colours() << " | "
+      << fixed(median(r.element_ms), 2) << " | " << fixed(spmv, 3) << " | " << fixed(v_cycle, 3)
+      << " | " << median(r.iterations) << " |\n";
+  return out.str();
+}
+
+std::string one_mesh_table(const LessonRun& run) {
+  std::vector<Run> runs = runs_for(run);
+  for (Run& r : runs) {
+    r.stepper = std::make_unique<NodeOrderStepper>(r.scene, SolverSettings{}, r.ordering);
+    r.state = rest_state(r.scene);
+  }
+  // Interleaved, one step of each order in turn, as fem_bench runs chapters: a drift of the
+  // machine's speed hits every order alike. The first two steps set up and are not timed.
+  for (int k = 0; k < run.steps + 2; ++k) {
+    if (k % 5 == 0) progress("node-order: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+    for (Run& r : runs) {
+      r.stepper->step(r.state);
+      if (k < 2) continue;
+      r.element_ms.push_back(1e3 * r.stepper->profile().forces.seconds);
+      r.iterations.push_back(r.stepper->profile().cg_iterations);
+    }
+  }
+  std::ostringstream out;
+  out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes, "
+      << run.scene.mesh.num_tets() << " tets), order | bandwidth | envelope per row | element "
+      << "spread | colours | element pass, ms | SpMV, ms | V-cycle, ms | CG it. |\n"
+      << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  for (Run& r : runs) out << row(r);
+  out << "\nOne thread; medians of " << run.steps << " steps (the element pass: the `forces` "
+      << "phase, which also fills A and b) and of repeated products on the last system. "
+      << "Bandwidth: max |i - j| over coupled nodes; envelope: mean of i - min j over rows; "
+      << "element spread: mean of the largest minus the smallest node number of an element. "
+      << "`original` keeps the file's numbering and element order (chapter 10); `gmsh` rows: "
+      << "the file renumbered by gmsh's computeRenumbering (scripts/renumber_meshes.py), its "
+      << "elements sorted as chapter 11 sorts them. " << measured_on() << ".\n";
+  return out.str();
+}
+
+// The scene's mesh, then each of --meshes (the same scene and material on it): one table each.
+std::string node_order_table(const LessonRun& run) {
+  std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
+  std::stringstream list(run.args.get("meshes"));
+  for (std::string path; std::getline(list, path, ',');) {
+    if (path.empty()) continue;
+    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
+    scenes.back().dt = run.scene.dt;
+    scenes.back().damping = run.scene.damping;
+  }
+  std::string tables = one_mesh_table(run);
+  for (const Scene& scene : scenes) tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});
+  return tables;
+}
+
+void add_node_order_options(ArgParser& args) {
+  args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
+}
+
+}  // namespace
+
+std::vector<Lesson> lessons() {
+  return {{"node-order",
+           "the same scene in each node order: bandwidth, element spread, element pass, SpMV, V-cycle",
+           "meshes/plate_poster.msh", add_node_order_options,
+           [](const LessonRun& run) { return node_order_table(run); }, false}};
+}
+
+}  // namespace fem::ch11
