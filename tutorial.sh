@@ -300,6 +300,13 @@ lessons() {
     "$BUILD_DIR/fem_lessons" "$lesson" --json "docs/data/lessons/$lesson.json" >/dev/null
   done
   "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --cost-threads 1,2 --json docs/data/lessons/multigrid.json >/dev/null
+  # Chapter 11: gmsh's own orders beside the chapter's, on the plate, beam_10k and (when
+  # `./tutorial.sh meshes --large` made it) the 82k-node beam.
+  "$VENV/bin/python" scripts/renumber_meshes.py >/dev/null
+  local large=""
+  [ -f meshes/generated/beam_100k.msh ] && large=",meshes/generated/beam_100k.msh"
+  "$BUILD_DIR/fem_lessons" node-order --steps 10 --meshes "meshes/beam_10k.msh$large" \
+    --json docs/data/lessons/node-order.json >/dev/null
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   "$VENV/bin/python" scripts/lesson_tables.py
