@@ -40,14 +40,17 @@ def run_label(data):
 
 def chapter_color(chapter, variant_of=""):
     """One colour per chapter in every plot: matplotlib's tab20 pairs, the dark one for the
-    chapter NN of the course, the light one of the same hue for a student's variant of it."""
+    chapter NN of the course, the light one of the same hue for a student's variant of it;
+    from chapter 11 on (tab20 has ten hues) tab20b's groups of four shades, the darkest for the
+    chapter and the third for its variants."""
     import matplotlib
-    palette = matplotlib.colormaps["tab20"].colors
     try:
         number = int(chapter[:2])
     except ValueError:
         return "0.4"
-    return palette[(2 * (number - 1)) % 20 + (1 if variant_of else 0)]
+    if number > 10:
+        return matplotlib.colormaps["tab20b"].colors[(4 * (number - 11)) % 20 + (2 if variant_of else 0)]
+    return matplotlib.colormaps["tab20"].colors[(2 * (number - 1)) % 20 + (1 if variant_of else 0)]
 
 
 class ResultsError(Exception):

@@ -117,6 +117,11 @@ EXERCISES = [
      "bench": "build/release/fem_bench --chapters 10,10_NAME --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons multigrid --chapter 10_NAME"},
+    {"id": "11/2", "chapter": "11", "name": "ex_slabs",
+     "change": [("stepper.hpp", "static constexpr int kSlabs = 64;", "static constexpr int kSlabs = 8;")],
+     "bench": "build/release/fem_bench --chapters 11,11_NAME --threads 1,2 --no-solvers --no-json",
+     "expect": "measured",
+     "lesson": "build/release/fem_lessons node-order --chapter 11_NAME"},
 ]
 
 
