@@ -923,9 +923,13 @@ void Multigrid::coarse_correction(Level<B>& level, std::size_t next, const Eigen
   for_parts(level, collective, [&](int first, int last) { prolong_rows(level, coarse, first, last, x); });
 }
 
-void Multigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+void Multigrid::count_cycle() {
 #pragma omp master
   ++cycles_;  // read by the next prepare, many barriers later
+}
+
+void Multigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+  count_cycle();
   cycle(fine_, 0, r, z, true);
 }
 

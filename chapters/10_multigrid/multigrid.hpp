@@ -167,6 +167,12 @@ class Multigrid {
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z);
 
   const MultigridSettings& settings() const { return settings_; }
+  // The levels as prepare() left them: chapter 12 reads their numbers into float.
+  const Level<3>& fine_level() const { return fine_; }
+  const Level<kModes>& coarse_level(int level) const { return coarse_.at(level - 1); }
+  // A V-cycle run on these levels outside apply() (chapter 12's, in float) still counts for
+  // the refresh rule. Called by every thread of a team, or outside one.
+  void count_cycle();
   int levels() const { return 1 + static_cast<int>(coarse_.size()); }
   int level_dofs(int level) const;
   long long level_blocks(int level) const;        // stored blocks of the level's matrix

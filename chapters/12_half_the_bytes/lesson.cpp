@@ -1,0 +1,134 @@
+// Chapter 12's lesson table: `fem_lessons half-the-bytes` (see lesson.hpp).
+#include "chapters/12_half_the_bytes/lesson.hpp"
+
+#include <iomanip>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "chapters/11_node_order/stepper.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
+#include "common/cli.hpp"
+
+namespace fem::ch12 {
+
+namespace {
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
+}
+
+// Chapter 10's hierarchy in double: every level's blocks and inverse diagonals, P and P^T
+// (the coarsest level is a dense Cholesky factor, the same in both chapters: not counted).
+double double_megabytes(const ch10::Multigrid& mg) {
+  long long bytes = 0;
+  for (int l = 0; l + 1 < mg.levels(); ++l) {
+    const long long b = l == 0 ? 3 : ch10::kModes;
+    bytes += 8 * b * b * (mg.level_blocks(l) + mg.level_dofs(l) / b);
+    bytes += 2 * 8 * b * ch10::kModes * mg.prolongator_blocks(l);
+  }
+  return 1e-6 * static_cast<double>(bytes);
+}
+
+// One variant of the preconditioner: a stepper at the default tolerance (times, iterations)
+// and one at the tight tolerance (iterations), stepped side by side.
+struct Run {
+  std::string name;
+  std::unique_ptr<ch11::NodeOrderStepper> stepper, tight;
+  State state, tight_state;
+  std::vector<double> solve_ms, iterations, tight_iterations;
+  bool converged = true;
+};
+
+std::unique_ptr<ch11::NodeOrderStepper> make(const Scene& scene, int variant, double tolerance) {
+  SolverSettings settings;
+  settings.tolerance = tolerance;
+  if (variant == 0) return std::make_unique<ch11::NodeOrderStepper>(scene, settings);
+  return std::make_unique<HalfBytesStepper>(
+      scene, settings, variant == 1 ? Arithmetic::single : Arithmetic::double_on_float);
+}
+
+double v_cycle_ms(Run& r, int variant) {
+  const Eigen::VectorXd rhs = r.stepper->system_rhs();
+  Eigen::VectorXd s(rhs.size());
+  if (variant == 0) return time_ms(20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
+  auto& v_cycle = static_cast<HalfBytesStepper&>(*r.stepper).v_cycle();
+  return time_ms(20, [&] { v_cycle.apply(ch09::RowChunks{}, rhs, s); }, 2.0);
+}
+
+std::string one_mesh_table(const LessonRun& run, double tight) {
+  const char* names[] = {"double (chapter 11)", "float", "float numbers, double arithmetic"};
+  std::vector<Run> runs(3);
+  for (int v = 0; v < 3; ++v) {
+    runs[v].name = names[v];
+    runs[v].stepper = make(run.scene, v, SolverSettings{}.tolerance);
+    runs[v].tight = make(run.scene, v, tight);
+    runs[v].state = runs[v].tight_state = rest_state(run.scene);
+  }
+  // Interleaved, one step of each in turn; the first two steps set up and are not timed.
+  for (int k = 0; k < run.steps + 2; ++k) {
+    if (k % 5 == 0)
+      progress("half-the-bytes: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+    for (Run& r : runs) {
+      r.stepper->step(r.state);
+      r.tight->step(r.tight_state);
+      r.converged = r.converged && r.stepper->profile().converged && r.tight->profile().converged;
+      if (k < 2) continue;
+      r.solve_ms.push_back(1e3 * r.stepper->profile().solve.seconds);
+      r.iterations.push_back(r.stepper->profile().cg_iterations);
+      r.tight_iterations.push_back(r.tight->profile().cg_iterations);
+    }
+  }
+  const double mb = double_megabytes(runs[0].stepper->multigrid());
+  std::ostringstream out;
+  out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes), V-cycle"
+      << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at 1e-4 | CG it. at " << tight
+      << " |\n| --- | ---: | ---: | ---: | ---: | ---: |\n";
+  for (int v = 0; v < 3; ++v) {
+    Run& r = runs[v];
+    out << "| " << r.name << " | " << fixed(v == 0 ? mb : mb / 2, 2) << " | "
+        << fixed(v_cycle_ms(r, v), 3) << " | " << fixed(median(r.solve_ms), 2) << " | "
+        << median(r.iterations) << " | " << median(r.tight_iterations)
+        << (r.converged ? "" : " (unconverged)") << " |\n";
+  }
+  out << "\nOne thread; medians of " << run.steps << " steps, and of repeated V-cycles on the "
+      << "last system. Numbers: every level's blocks and inverse diagonals and both "
+      << "prolongators (the coarsest level's dense Cholesky factor stays double in both). "
+      << measured_on() << ".\n";
+  return out.str();
+}
+
+std::string half_the_bytes_table(const LessonRun& run) {
+  const double tight = std::stod(run.args.get("tight"));
+  if (!(tight > 0.0 && tight < 1.0)) throw std::invalid_argument("--tight: a tolerance in (0, 1)");
+  std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
+  std::stringstream list(run.args.get("meshes"));
+  for (std::string path; std::getline(list, path, ',');) {
+    if (path.empty()) continue;
+    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
+    scenes.back().dt = run.scene.dt;
+    scenes.back().damping = run.scene.damping;
+  }
+  std::string tables = one_mesh_table(run, tight);
+  for (const Scene& scene : scenes)
+    tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter}, tight);
+  return tables;
+}
+
+void add_options(ArgParser& args) {
+  args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
+  args.option("tight", "TOL", "the tight tolerance of the last column", "1e-8");
+}
+
+}  // namespace
+
+std::vector<Lesson> lessons() {
+  return {{"half-the-bytes",
+           "the V-cycle in double, in float, and float numbers in double arithmetic: bytes, time, iterations",
+           "meshes/plate_poster.msh", add_options,
+           [](const LessonRun& run) { return half_the_bytes_table(run); }, false}};
+}
+
+}  // namespace fem::ch12

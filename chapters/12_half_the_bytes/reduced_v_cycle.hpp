@@ -1,0 +1,84 @@
+// Chapter 12's preconditioner: chapter 10's V-cycle on half the bytes. Once the hierarchy is
+// lagged and parallel, a V-cycle is bound by memory traffic: it streams every level's blocks,
+// the prolongators and the smoothers' inverse diagonals, several times per cycle. The
+// preconditioner only has to be good, not exact, so those numbers are stored in float:
+// half the bytes to stream. The outer PCG (chapter 09's), its vectors, the system matrix and
+// the stopping rule stay in double, so the solve converges to the same tolerance: M changes
+// a little, and PCG only needs M symmetric positive definite (AMGCL's mixed precision,
+// Demidov 2019; Tamstorf et al. 2015 precondition in the same spirit).
+//
+// The hierarchy itself is still chapter 10's Multigrid: it is set up and prepared in double
+// (aggregates, Galerkin products, Chebyshev bounds, Cholesky), and this class reads its
+// numbers into float after each prepare(): the finest level every step, the coarse levels
+// after a refresh only. The V-cycle then runs in `Real` arithmetic on the float data:
+// Real = float (everything in single precision) or Real = double (float loads widened in
+// registers: the bytes of float, the rounding of double), the two the lesson measures.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "chapters/09_threads/parallel_pcg.hpp"
+#include "chapters/10_multigrid/multigrid.hpp"
+
+namespace fem::ch12 {
+
+using ch10::kModes;
+
+// One level of the hierarchy with the numbers the V-cycle reads in float; the pattern, the
+// row blocks, the refresh rule and the coarsest Cholesky factor stay the source level's.
+template <class Real, int B>
+struct ReducedLevel {
+  using Vector = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
+  const ch10::Level<B>* source = nullptr;
+  std::vector<Eigen::Matrix<float, B, B>> blocks;            // the level's matrix
+  std::vector<Eigen::Matrix<float, B, B>> inverse_diagonal;  // the smoother's D^-1
+  std::vector<Eigen::Matrix<float, B, kModes>> P;            // the prolongator's blocks
+  std::vector<Eigen::Matrix<float, kModes, B>> PT;           // P^T's, in P^T's row order
+  std::vector<Real> chebyshev;                               // the smoother's weights
+  Vector b, x, y, work, direction;
+  Eigen::VectorXd dense;  // coarsest level: the right-hand side of the double Cholesky
+
+  int nodes() const { return source->nodes(); }
+};
+
+enum class Arithmetic { single, double_on_float };
+
+template <class Real>
+class ReducedVCycle final : public ch09::Preconditioner {
+ public:
+  using Vector = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
+
+  // The hierarchy must outlive this object; its settings must use a polynomial smoother
+  // (Chebyshev or Jacobi: chapter 10's default), which this V-cycle runs.
+  explicit ReducedVCycle(ch10::Multigrid& multigrid);
+
+  // Chapter 10's prepare in double, then its new numbers into float. By every thread.
+  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
+  bool block_diagonal() const override { return false; }
+  // s = M r, one V-cycle in Real arithmetic on the float numbers. By every thread.
+  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+
+  // The bytes one V-cycle's numbers occupy: blocks, prolongators (P and P^T) and inverse
+  // diagonals of every level; chapter 10's in double are twice as many.
+  long long number_bytes() const;
+  const ch10::Multigrid& multigrid() const { return multigrid_; }
+
+ private:
+  template <int B>
+  void convert(ReducedLevel<Real, B>& level, bool refreshed, bool collective);
+  template <int B>
+  void cycle(ReducedLevel<Real, B>& level, std::size_t next, const Vector& b, Vector& out,
+             bool collective);
+
+  ch10::Multigrid& multigrid_;
+  ReducedLevel<Real, 3> fine_;
+  std::vector<ReducedLevel<Real, kModes>> coarse_;
+  Vector r_, s_;  // the PCG's residual and its preconditioned residual in Real
+  bool converted_ = false;  // the coarse levels, prolongators and weights read once
+};
+
+extern template class ReducedVCycle<float>;
+extern template class ReducedVCycle<double>;
+
+}  // namespace fem::ch12

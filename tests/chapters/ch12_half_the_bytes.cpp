@@ -1,0 +1,144 @@
+// Chapter 12: the V-cycle on float numbers is still what PCG's theory needs (symmetric to
+// the rounding of its arithmetic, positive definite on the filtered space), it holds exactly
+// chapter 10's numbers rounded to float, it costs at most one iteration more than chapter
+// 11's double V-cycle at the default tolerance, the solve still reaches a tight tolerance, and
+// the stepper matches chapter 01, allocates nothing and is bit-identical on 1, 2 and 3 threads
+// (the generic tests).
+#include <cmath>
+
+#include "catch2_compat.hpp"
+#include "chapters/10_multigrid/stepper.hpp"
+#include "chapters/11_node_order/stepper.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
+#include "common/threads.hpp"
+#include "support.hpp"
+
+using namespace fem;
+
+FEM_CHAPTER_TESTS("12", "[ch12]")
+
+namespace {
+
+Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
+  Eigen::VectorXd v = Eigen::VectorXd::Random(size);
+  for (const auto& c : scene.constraints) v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
+  return v;
+}
+
+// Three levels on the 190-node test mesh, small row blocks (as chapter 10's tests).
+ch10::MultigridSettings three_levels() {
+  ch10::MultigridSettings s;
+  s.max_coarse_dofs = 24;
+  s.block_rows = 4;
+  return s;
+}
+
+// x^T M y - y^T M x against sqrt(x^T M x y^T M y), over five pairs of filtered vectors; the
+// smallest x^T M x / x^T x.
+template <class Real>
+std::pair<double, double> asymmetry_and_positivity(const Scene& scene) {
+  ch10::MultigridStepper stepper(scene, {}, three_levels());
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  REQUIRE(stepper.multigrid().levels() == 3);
+  ch12::ReducedVCycle<Real> v_cycle(stepper.multigrid());
+  v_cycle.prepare(stepper.system_matrix(), ch09::RowChunks{});
+  std::srand(12);
+  const Eigen::Index n = stepper.system_rhs().size();
+  Eigen::VectorXd Mx(n), My(n);
+  double asymmetry = 0.0, positivity = INFINITY;
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
+    v_cycle.apply(ch09::RowChunks{}, x, Mx);
+    v_cycle.apply(ch09::RowChunks{}, y, My);
+    asymmetry = std::max(asymmetry, std::abs(x.dot(My) - y.dot(Mx)) / std::sqrt(x.dot(Mx) * y.dot(My)));
+    positivity = std::min({positivity, x.dot(Mx) / x.squaredNorm(), y.dot(My) / y.squaredNorm()});
+  }
+  return {asymmetry, positivity};
+}
+
+}  // namespace
+
+TEST_CASE("ch12: the float V-cycle is symmetric to its rounding and positive definite",
+          "[ch12]") {
+  // In float arithmetic the two sides of x^T M y = y^T M x round differently: symmetric to
+  // float's 6e-8 times the cycle's few hundred operations. Widened to double, the float
+  // numbers form an exactly symmetric operator (P^T is P transposed entry by entry, the
+  // matrices stay symmetric when rounded): chapter 10's 1e-12 holds.
+  for (const Scene& scene : test::equivalence_scenes()) {
+    const auto [single_asymmetry, single_positivity] = asymmetry_and_positivity<float>(scene);
+    const auto [double_asymmetry, double_positivity] = asymmetry_and_positivity<double>(scene);
+    INFO(scene.name << ": float " << single_asymmetry << ", double on float " << double_asymmetry);
+    CHECK(single_asymmetry < 1e-5);
+    CHECK(double_asymmetry < 1e-12);
+    CHECK(single_positivity > 0.0);
+    CHECK(double_positivity > 0.0);
+  }
+}
+
+TEST_CASE("ch12: the float numbers are chapter 10's rounded, and half their bytes", "[ch12]") {
+  const Scene scene = test::test_scene("cantilever");
+  ch10::MultigridStepper stepper(scene, {}, three_levels());
+  State state = rest_state(scene);
+  stepper.step(state);
+  ch12::ReducedVCycle<float> single(stepper.multigrid());
+  ch12::ReducedVCycle<double> widened(stepper.multigrid());
+  single.prepare(stepper.system_matrix(), ch09::RowChunks{});
+  widened.prepare(stepper.system_matrix(), ch09::RowChunks{});
+  CHECK(single.number_bytes() == widened.number_bytes());
+  // Chapter 10's hierarchy in double: blocks, prolongators both ways, inverse diagonals.
+  const ch10::Multigrid& mg = stepper.multigrid();
+  long long double_bytes = 0;
+  for (int l = 0; l < mg.levels() - 1; ++l) {
+    const int b = l == 0 ? 3 : ch10::kModes;
+    double_bytes += 8LL * b * b * mg.level_blocks(l);
+    double_bytes += 8LL * b * b * (mg.level_dofs(l) / b);
+    double_bytes += 2 * 8LL * b * ch10::kModes * mg.prolongator_blocks(l);
+  }
+  CHECK(2 * single.number_bytes() == double_bytes);
+}
+
+TEST_CASE("ch12: at most one iteration more than chapter 11 at 1e-4, and 1e-10 still reached",
+          "[ch12]") {
+  // The preconditioner only steers the search; PCG's residual and stopping rule are double.
+  for (const double tolerance : {1e-4, 1e-10}) {
+    for (const Scene& scene : test::equivalence_scenes()) {
+      SolverSettings settings;
+      settings.tolerance = tolerance;
+      ch11::NodeOrderStepper reference(scene, settings);
+      ch12::HalfBytesStepper single(scene, settings);
+      ch12::HalfBytesStepper widened(scene, settings, ch12::Arithmetic::double_on_float);
+      State a = rest_state(scene), b = a, c = a;
+      int worst = 0;
+      for (int k = 0; k < 20; ++k) {
+        reference.step(a);
+        single.step(b);
+        widened.step(c);
+        REQUIRE(single.profile().converged);
+        REQUIRE(widened.profile().converged);
+        worst = std::max({worst, single.profile().cg_iterations - reference.profile().cg_iterations,
+                          widened.profile().cg_iterations - reference.profile().cg_iterations});
+      }
+      INFO(scene.name << ", tolerance " << tolerance << ": most extra iterations " << worst);
+      if (tolerance == 1e-4) CHECK(worst <= 1);
+      CHECK((b.x - a.x).cwiseAbs().maxCoeff() < 1e3 * tolerance);
+    }
+  }
+}
+
+TEST_CASE("ch12: refuses chapter 10's Gauss-Seidel smoother", "[ch12]") {
+  ch10::MultigridSettings s;
+  s.smoother = ch10::MultigridSettings::Smoother::GaussSeidel;
+  CHECK_THROWS_AS(ch12::HalfBytesStepper(test::test_scene("cantilever"), {},
+                                         ch12::Arithmetic::single, s),
+                  std::invalid_argument);
+}
+
+TEST_CASE("ch12: zero heap allocations per step after the first, with 2 threads", "[ch12]") {
+  FEM_REQUIRE_ALLOCATION_COUNTER();
+  const ThreadCountScope two(openmp_enabled() ? 2 : 1);
+  for (const Scene& scene : test::equivalence_scenes()) {
+    INFO(scene.name);
+    CHECK(test::allocations_per_step("12", scene) == 0);
+  }
+}
