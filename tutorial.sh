@@ -307,6 +307,9 @@ lessons() {
   [ -f meshes/generated/beam_100k.msh ] && large=",meshes/generated/beam_100k.msh"
   "$BUILD_DIR/fem_lessons" node-order --steps 10 --meshes "meshes/beam_10k.msh$large" \
     --json docs/data/lessons/node-order.json >/dev/null
+  # Chapter 12: the V-cycle in double, in float, and float numbers in double arithmetic.
+  "$BUILD_DIR/fem_lessons" half-the-bytes --steps 10 --meshes "meshes/beam_10k.msh$large" \
+    --json docs/data/lessons/half-the-bytes.json >/dev/null
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   "$VENV/bin/python" scripts/lesson_tables.py

@@ -2,6 +2,7 @@
 #include "chapters/12_half_the_bytes/lesson.hpp"
 
 #include <iomanip>
+#include <stdexcept>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -33,12 +34,15 @@ double double_megabytes(const ch10::Multigrid& mg) {
 }
 
 // One variant of the preconditioner: a stepper at the default tolerance (times, iterations)
-// and one at the tight tolerance (iterations), stepped side by side.
+// and one at each tight tolerance (iterations), stepped side by side.
 struct Run {
   std::string name;
-  std::unique_ptr<ch11::NodeOrderStepper> stepper, tight;
-  State state, tight_state;
-  std::vector<double> solve_ms, iterations, tight_iterations;
+  std::unique_ptr<ch11::NodeOrderStepper> stepper;
+  std::vector<std::unique_ptr<ch11::NodeOrderStepper>> tight;
+  State state;
+  std::vector<State> tight_state;
+  std::vector<double> solve_ms, iterations;
+  std::vector<std::vector<double>> tight_iterations;
   bool converged = true;
 };
 
@@ -58,14 +62,18 @@ double v_cycle_ms(Run& r, int variant) {
   return time_ms(20, [&] { v_cycle.apply(ch09::RowChunks{}, rhs, s); }, 2.0);
 }
 
-std::string one_mesh_table(const LessonRun& run, double tight) {
+std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tight) {
   const char* names[] = {"double (chapter 11)", "float", "float numbers, double arithmetic"};
   std::vector<Run> runs(3);
   for (int v = 0; v < 3; ++v) {
     runs[v].name = names[v];
     runs[v].stepper = make(run.scene, v, SolverSettings{}.tolerance);
-    runs[v].tight = make(run.scene, v, tight);
-    runs[v].state = runs[v].tight_state = rest_state(run.scene);
+    runs[v].state = rest_state(run.scene);
+    for (const double t : tight) {
+      runs[v].tight.push_back(make(run.scene, v, t));
+      runs[v].tight_state.push_back(runs[v].state);
+    }
+    runs[v].tight_iterations.resize(tight.size());
   }
   // Interleaved, one step of each in turn; the first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
@@ -73,25 +81,32 @@ std::string one_mesh_table(const LessonRun& run, double tight) {
       progress("half-the-bytes: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
     for (Run& r : runs) {
       r.stepper->step(r.state);
-      r.tight->step(r.tight_state);
-      r.converged = r.converged && r.stepper->profile().converged && r.tight->profile().converged;
+      r.converged = r.converged && r.stepper->profile().converged;
+      for (std::size_t t = 0; t < tight.size(); ++t) {
+        r.tight[t]->step(r.tight_state[t]);
+        r.converged = r.converged && r.tight[t]->profile().converged;
+        if (k >= 2) r.tight_iterations[t].push_back(r.tight[t]->profile().cg_iterations);
+      }
       if (k < 2) continue;
       r.solve_ms.push_back(1e3 * r.stepper->profile().solve.seconds);
       r.iterations.push_back(r.stepper->profile().cg_iterations);
-      r.tight_iterations.push_back(r.tight->profile().cg_iterations);
     }
   }
   const double mb = double_megabytes(runs[0].stepper->multigrid());
   std::ostringstream out;
   out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes), V-cycle"
-      << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at 1e-4 | CG it. at " << tight
-      << " |\n| --- | ---: | ---: | ---: | ---: | ---: |\n";
+      << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at 1e-4";
+  for (const double t : tight) out << " | CG it. at " << t;
+  out << " |\n| --- | ---: | ---: | ---: | ---:";
+  for (std::size_t t = 0; t < tight.size(); ++t) out << " | ---:";
+  out << " |\n";
   for (int v = 0; v < 3; ++v) {
     Run& r = runs[v];
     out << "| " << r.name << " | " << fixed(v == 0 ? mb : mb / 2, 2) << " | "
         << fixed(v_cycle_ms(r, v), 3) << " | " << fixed(median(r.solve_ms), 2) << " | "
-        << median(r.iterations) << " | " << median(r.tight_iterations)
-        << (r.converged ? "" : " (unconverged)") << " |\n";
+        << median(r.iterations);
+    for (const auto& its : r.tight_iterations) out << " | " << median(its);
+    out << (r.converged ? "" : " (a solve did not converge)") << " |\n";
   }
   out << "\nOne thread; medians of " << run.steps << " steps, and of repeated V-cycles on the "
       << "last system. Numbers: every level's blocks and inverse diagonals and both "
@@ -101,8 +116,20 @@ std::string one_mesh_table(const LessonRun& run, double tight) {
 }
 
 std::string half_the_bytes_table(const LessonRun& run) {
-  const double tight = std::stod(run.args.get("tight"));
-  if (!(tight > 0.0 && tight < 1.0)) throw std::invalid_argument("--tight: a tolerance in (0, 1)");
+  std::vector<double> tight;
+  std::stringstream tolerances(run.args.get("tight"));
+  for (std::string t; std::getline(tolerances, t, ',');) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != t.size() || !(value > 0.0 && value < 1.0))
+      throw std::invalid_argument("--tight: tolerances in (0, 1), comma-separated, not '" + t + "'");
+    tight.push_back(value);
+  }
   std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
   std::stringstream list(run.args.get("meshes"));
   for (std::string path; std::getline(list, path, ',');) {
@@ -119,7 +146,7 @@ std::string half_the_bytes_table(const LessonRun& run) {
 
 void add_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
-  args.option("tight", "TOL", "the tight tolerance of the last column", "1e-8");
+  args.option("tight", "LIST", "the tight tolerances of the last columns, comma-separated", "1e-8,1e-12");
 }
 
 }  // namespace

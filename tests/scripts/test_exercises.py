@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The exercises of chapters 01-10 as a student does them: in a copy of the repository (the
+"""The exercises of chapters 01-12 as a student does them: in a copy of the repository (the
 current files, committed or not), make each code-changing exercise's variant with
 `./tutorial.sh variant`, apply a small scripted version of the exercise's change, build, and
 run the commands the chapter README gives, checking that
@@ -122,6 +122,19 @@ EXERCISES = [
      "bench": "build/release/fem_bench --chapters 11,11_NAME --threads 1,2 --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons node-order --chapter 11_NAME"},
+    {"id": "12/1", "chapter": "12", "name": "ex_widened",
+     "change": [("stepper.hpp", "Arithmetic arithmetic = Arithmetic::single,",
+                 "Arithmetic arithmetic = Arithmetic::double_on_float,")],
+     "bench": "build/release/fem_bench --chapters 12,12_NAME --threads 1,2 --no-solvers --no-json",
+     "expect": "measured"},
+    {"id": "12/2", "chapter": "12", "name": "ex_unpadded",
+     "change": [("reduced_v_cycle.cpp",
+                 "  using Column = Eigen::Matrix<float, Lanes<R>, 1>;\n  for (int j = 0; j < C; ++j)\n"
+                 "    acc += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];\n",
+                 "  for (int j = 0; j < C; ++j) acc.template head<R>() += M.col(j).template cast<Real>() * x[j];\n")],
+     "bench": "build/release/fem_bench --chapters 12,12_NAME --no-solvers --no-json",
+     "expect": "measured",
+     "lesson": "build/release/fem_lessons half-the-bytes --chapter 12_NAME"},
 ]
 
 
