@@ -168,8 +168,7 @@ template <class Real>
 ReducedVCycle<Real>::ReducedVCycle(ch10::Multigrid& multigrid) : multigrid_(multigrid) {
   if (multigrid.settings().smoother == ch10::MultigridSettings::Smoother::GaussSeidel)
     throw std::invalid_argument(
-        "chapter 12: the float V-cycle runs chapter 10's polynomial smoothers (Chebyshev, "
-        "Jacobi), not Gauss-Seidel");
+        "float V-cycle: the polynomial smoothers only (Chebyshev, Jacobi), not Gauss-Seidel");
   size_level(fine_, multigrid.fine_level());
   coarse_.resize(multigrid.levels() - 1);
   for (int l = 1; l < multigrid.levels(); ++l) size_level(coarse_[l - 1], multigrid.coarse_level(l));
