@@ -310,6 +310,8 @@ lessons() {
   # Chapter 12: the V-cycle in double, in float, and float numbers in double arithmetic.
   "$BUILD_DIR/fem_lessons" half-the-bytes --steps 10 --meshes "meshes/beam_10k.msh$large" \
     --json docs/data/lessons/half-the-bytes.json >/dev/null
+  "$BUILD_DIR/fem_lessons" batched-elements --steps 20 --meshes "meshes/beam_10k.msh$large" \
+    --json docs/data/lessons/batched-elements.json >/dev/null
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   "$VENV/bin/python" scripts/lesson_tables.py

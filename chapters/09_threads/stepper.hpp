@@ -56,6 +56,12 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // Colours groups of `group` consecutive elements (kGroup by default); chapter 11, whose
   // elements come sorted along the mesh, makes the groups long slabs.
   void colour_element_groups(int group);
+  // The colouring, for a chapter that computes a group's elements its own way (chapter 12:
+  // several at a time): colour c is the groups colour_order()[k] for k in [colour_start()[c],
+  // colour_start()[c + 1]), group g the elements [g * group_size(), (g + 1) * group_size()).
+  const std::vector<int>& colour_order() const { return colour_order_; }
+  const std::vector<int>& colour_start() const { return colour_start_; }
+  int group_size() const { return group_; }
 
  private:
   void start_system(const State& state) override;

@@ -1,15 +1,19 @@
 // Chapter 12's lesson table: `fem_lessons half-the-bytes` (see lesson.hpp).
 #include "chapters/12_half_the_bytes/lesson.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <stdexcept>
 #include <memory>
 #include <sstream>
 #include <string>
 
+#include "chapters/08_element_kernels/element_kernels.hpp"
 #include "chapters/11_node_order/stepper.hpp"
+#include "chapters/12_half_the_bytes/element_batch.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "common/cli.hpp"
+#include "common/model.hpp"
 
 namespace fem::ch12 {
 
@@ -144,6 +148,72 @@ std::string half_the_bytes_table(const LessonRun& run) {
   return tables;
 }
 
+// The element terms of every element, one at a time (chapter 08's FusedElements::terms) and
+// kLanes at a time (BatchedElements::terms), without the scatter: ns per element, 1 thread.
+// The states are those of chapter 12 stepping the scene, so the rotations turn as in a run.
+std::string one_mesh_elements(const LessonRun& run) {
+  HalfBytesStepper stepper(run.scene, SolverSettings{});
+  const Scene& scene = run.scene;
+  const Model model(scene);
+  ch08::FusedElements one(model, scene);
+  BatchedElements batched(model, scene);
+  const int n = static_cast<int>(model.tets.size());
+  State state = rest_state(scene);
+  std::vector<double> one_ns, batched_ns;
+  ch08::ElementTerms terms;
+  BatchTerms batch;
+  for (int k = 0; k < run.steps + 2; ++k) {
+    if (k % 10 == 0)
+      progress("batched-elements: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+    stepper.step(state);
+    long long f1 = 0, f2 = 0;
+    const double t1 = time_ms(1, [&] {
+      for (int e = 0; e < n; ++e) {
+        one.terms(e, model.tets[e], state, f1, terms);
+      }
+    });
+    const double t2 = time_ms(1, [&] {
+      for (int e = 0; e < n; e += kLanes) {
+        batched.terms(e, std::min(kLanes, n - e), model.tets, state, f2, batch);
+      }
+    });
+    one.end_pass(f1);
+    batched.end_pass(f2);
+    if (k < 2) continue;
+    one_ns.push_back(1e6 * t1 / n);
+    batched_ns.push_back(1e6 * t2 / n);
+  }
+  const double a = median(one_ns), b = median(batched_ns);
+  std::ostringstream out;
+  out << "| `" << mesh_name(scene) << "` | " << n << " | " << fixed(a, 1) << " | " << fixed(b, 1)
+      << " | x" << fixed(a / b, 2) << " |\n";
+  return out.str();
+}
+
+std::string batched_elements_table(const LessonRun& run) {
+  std::vector<Scene> scenes;
+  std::stringstream list(run.args.get("meshes"));
+  for (std::string path; std::getline(list, path, ',');) {
+    if (path.empty()) continue;
+    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
+    scenes.back().dt = run.scene.dt;
+    scenes.back().damping = run.scene.damping;
+  }
+  std::string table =
+      "| mesh | elements | one at a time (chapter 08), ns per element | " + std::to_string(kLanes) +
+      " at a time (chapter 12), ns per element | speedup |\n| --- | ---: | ---: | ---: | ---: |\n";
+  table += one_mesh_elements(run);
+  for (const Scene& scene : scenes) table += one_mesh_elements({run.args, scene, run.steps, run.chapter});
+  return table + "\nOne thread; the terms of every element (rotation, forces, the ten blocks), "
+                 "without the scatter into A and b; medians over " +
+         std::to_string(run.steps) + " passes on the states of a run of chapter 12. " +
+         measured_on() + ".\n";
+}
+
+void add_element_options(ArgParser& args) {
+  args.option("meshes", "LIST", "further meshes, comma-separated: a row for each", "");
+}
+
 void add_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
   args.option("tight", "LIST", "the tight tolerances of the last columns, comma-separated", "1e-8,1e-12");
@@ -155,7 +225,11 @@ std::vector<Lesson> lessons() {
   return {{"half-the-bytes",
            "the V-cycle in double, in float, and float numbers in double arithmetic: bytes, time, iterations",
            "meshes/plate_poster.msh", add_options,
-           [](const LessonRun& run) { return half_the_bytes_table(run); }, false}};
+           [](const LessonRun& run) { return half_the_bytes_table(run); }, false},
+          {"batched-elements",
+           "the element terms one at a time (chapter 08) and a batch per vector register (chapter 12)",
+           "meshes/plate_poster.msh", add_element_options,
+           [](const LessonRun& run) { return batched_elements_table(run); }, false}};
 }
 
 }  // namespace fem::ch12

@@ -1,6 +1,10 @@
 // Chapter 12: chapter 11's step, its V-cycle on float numbers (see stepper.hpp).
 #include "chapters/12_half_the_bytes/stepper.hpp"
 
+#include <algorithm>
+
+#include "chapters/09_threads/parallel.hpp"
+
 namespace fem::ch12 {
 
 namespace {
@@ -11,16 +15,48 @@ std::unique_ptr<ch09::Preconditioner> reduced_v_cycle(ch10::Multigrid& multigrid
   return std::make_unique<ReducedVCycle<double>>(multigrid);
 }
 
+// total += mine from every thread once: an integer sum, exact in any order.
+void add_count(long long& total, long long mine) {
+#pragma omp atomic
+  total += mine;
+}
+
 }  // namespace
 
 HalfBytesStepper::HalfBytesStepper(const Scene& scene, const SolverSettings& settings,
                                    Arithmetic arithmetic, const ch10::MultigridSettings& multigrid)
     : NodeOrderStepper(scene, settings, ch11::Ordering::rcm, multigrid),
       arithmetic_(arithmetic),
+      batched_(model_, scene_),
       v_cycle_(reduced_v_cycle(this->multigrid(), arithmetic)) {
   // Chapter 10's hierarchy, set up and prepared in double as before; the PCG now applies it
   // through the float copy.
   use_preconditioner(*v_cycle_, "12_half_the_bytes");
+}
+
+void HalfBytesStepper::element_pass(const State& state) {
+  // Chapter 09's colour loop; inside a group, kLanes consecutive elements at a time, each
+  // batch's terms scattered in element order, so the sums (and the state) are the same for
+  // any thread count.
+  const std::vector<int>&order = colour_order(), &start = colour_start();
+  const int group = group_size(), elements = static_cast<int>(model_.tets.size());
+  long long fallbacks = 0;
+  ch09::run_parallel([&] {
+    BatchTerms terms;  // 6.5 KB on this thread's stack
+    long long mine = 0;
+    for (std::size_t colour = 0; colour + 1 < start.size(); ++colour)
+      for (const int k : ch09::StaticShare(start[colour], start[colour + 1])) {
+        const int first = order[k] * group, last = std::min(elements, first + group);
+        for (int e = first; e < last; e += kLanes) {
+          const int count = std::min(kLanes, last - e);
+          batched_.terms(e, count, model_.tets, state, mine, terms);
+          for (int l = 0; l < count; ++l)
+            scatter(terms, l, model_.tets[e + l], index_.element[e + l], A_, b_);
+        }
+      }
+    add_count(fallbacks, mine);
+  });
+  batched_.end_pass(fallbacks);
 }
 
 }  // namespace fem::ch12
