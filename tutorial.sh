@@ -21,11 +21,12 @@ APT_PACKAGES=(
   # screenshots; Xvfb and Mesa's software renderer run it headless in the tests
   pkg-config libglfw3-dev libgl-dev libimgui-dev libstb-dev xvfb xauth libgl1-mesa-dri
 )
-# What the other presets add: the clang preset builds with Clang and its OpenMP runtime; the
+# What the other presets add: the clang preset builds with Clang and its OpenMP runtime (and
+# brings clang-format, which keeps the sources in .clang-format's style: CI checks it); the
 # catch2-3 preset unpacks Catch2 3 from bookworm-backports into build/ (scripts/catch2_3.sh,
 # which installs nothing).
 case "$PRESET" in
-  clang) APT_PACKAGES+=(clang libomp-dev) ;;
+  clang) APT_PACKAGES+=(clang clang-format libomp-dev) ;;
 esac
 
 usage() {

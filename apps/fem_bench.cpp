@@ -101,7 +101,15 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                       {},
                       {},
                       ChapterResult{threaded ? c->id + "@" + std::to_string(threads) : c->id,
-                                    c->title, c->variant_of, {}, 0.0, {}, 0, 0.0, 0.0, 0,
+                                    c->title,
+                                    c->variant_of,
+                                    {},
+                                    0.0,
+                                    {},
+                                    0,
+                                    0.0,
+                                    0.0,
+                                    0,
                                     threads}});
   }
   const int report_every = std::max(1, (warmup + steps) / 5);
@@ -164,8 +172,8 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   struct Samples {
     std::vector<double> total, setup, solve, iterations, allocations;
   };
-  std::vector<std::string> names = {"eigen_cg",       "eigen_cg_guess",      "pcg_ch06",
-                                    "eigen_cg_full",  "eigen_cg_full_guess", "eigen_cg_ichol",
+  std::vector<std::string> names = {"eigen_cg",      "eigen_cg_guess",      "pcg_ch06",
+                                    "eigen_cg_full", "eigen_cg_full_guess", "eigen_cg_ichol",
                                     "eigen_ldlt"};
 #ifdef FEM_HAVE_CHOLMOD
   names.push_back("cholmod_llt");
@@ -246,21 +254,30 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
         return 0.0;
       };
     };
-    measure(0, [&] { cg.compute(A); }, iterative(cg, false));
-    measure(1, [&] { cg.compute(A); }, iterative(cg, true));
-    measure(2, [] {}, [&] {
-      x = previous;
-      const double iterations =
-          ch06::pcg_solve(A, b, scene.constraints, offsets, settings, work, x).iterations;
-      ours = x;
-      return iterations;
-    });
-    measure(3, [&] { cg_full.compute(A); }, iterative(cg_full, false));
-    measure(4, [&] { cg_full.compute(A); }, iterative(cg_full, true));
-    measure(5, [&] { cg_ichol.factorize(A); }, iterative(cg_ichol, true));
-    measure(6, [&] { ldlt.factorize(A); }, direct(ldlt));
+    measure(
+        0, [&] { cg.compute(A); }, iterative(cg, false));
+    measure(
+        1, [&] { cg.compute(A); }, iterative(cg, true));
+    measure(
+        2, [] {},
+        [&] {
+          x = previous;
+          const double iterations =
+              ch06::pcg_solve(A, b, scene.constraints, offsets, settings, work, x).iterations;
+          ours = x;
+          return iterations;
+        });
+    measure(
+        3, [&] { cg_full.compute(A); }, iterative(cg_full, false));
+    measure(
+        4, [&] { cg_full.compute(A); }, iterative(cg_full, true));
+    measure(
+        5, [&] { cg_ichol.factorize(A); }, iterative(cg_ichol, true));
+    measure(
+        6, [&] { ldlt.factorize(A); }, direct(ldlt));
 #ifdef FEM_HAVE_CHOLMOD
-    measure(7, [&] { cholmod.factorize(A); }, direct(cholmod));
+    measure(
+        7, [&] { cholmod.factorize(A); }, direct(cholmod));
 #endif
     previous = ours;  // the next system's guess: this one's solution
   }
@@ -292,7 +309,8 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
   std::vector<Row> rows;
   for (const bool eigen : {true, false})
     for (const int t : thread_counts)
-      rows.push_back({(eigen ? "eigen_cg_rowmajor@" : "pcg_ch09@") + std::to_string(t), t, eigen, {}, {}, {}});
+      rows.push_back(
+          {(eigen ? "eigen_cg_rowmajor@" : "pcg_ch09@") + std::to_string(t), t, eigen, {}, {}, {}});
   ch09::ThreadsStepper stepper(scene, settings);
   State state = rest_state(scene);
   ch09::ParallelPcg pcg(stepper.system_matrix(), scene.constraints);
@@ -350,16 +368,15 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
 void print_solvers(const std::vector<SolverResult>& solvers) {
   std::cout << "\nsolve table (the filtered systems of chapter 06's run; same tolerance)\n"
             << std::left << std::setw(21) << "solver" << std::right << std::setw(11) << "median ms"
-            << std::setw(10) << "setup" << std::setw(10) << "solve" << std::setw(12)
-            << "iterations" << std::setw(14) << "allocs/solve" << std::setw(14)
-            << "vs eigen_cg\n";
+            << std::setw(10) << "setup" << std::setw(10) << "solve" << std::setw(12) << "iterations"
+            << std::setw(14) << "allocs/solve" << std::setw(14) << "vs eigen_cg\n";
   for (const auto& s : solvers)
     std::cout << std::left << std::setw(21) << s.name << std::right << std::fixed
-              << std::setprecision(3) << std::setw(11) << s.median_ms << std::setw(10)
-              << s.setup_ms << std::setw(10) << s.solve_ms << std::setprecision(0)
-              << std::setw(12) << s.iterations << std::setw(14) << s.allocations_per_solve
-              << std::setprecision(2) << std::setw(12) << solvers.front().median_ms / s.median_ms
-              << "x" << std::defaultfloat << "\n";
+              << std::setprecision(3) << std::setw(11) << s.median_ms << std::setw(10) << s.setup_ms
+              << std::setw(10) << s.solve_ms << std::setprecision(0) << std::setw(12)
+              << s.iterations << std::setw(14) << s.allocations_per_solve << std::setprecision(2)
+              << std::setw(12) << solvers.front().median_ms / s.median_ms << "x"
+              << std::defaultfloat << "\n";
   std::cout << "(setup: compute() or factorize() after one analyzePattern; iterations: Eigen counts"
                " the products of full iterations, the last one excluded; pcg_ch06 counts every"
                " product)\n";
@@ -431,8 +448,7 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
         << ", \"cg_iterations\": " << r.cg_iterations
         << ", \"relative_residual\": " << r.relative_residual
         << ", \"not_converged_steps\": " << r.not_converged_steps << ", \"threads\": " << r.threads
-        << "}"
-        << (i + 1 < results.size() ? "," : "") << "\n";
+        << "}" << (i + 1 < results.size() ? "," : "") << "\n";
   }
   out << "  ]";
   if (!solvers.empty()) {
@@ -559,8 +575,8 @@ void check_writable(const std::string& path) {
   if (const fs::path dir = file.parent_path(); !dir.empty()) {
     fs::create_directories(dir, error);
     if (error || !fs::is_directory(dir))
-      throw UsageError("cannot write the results into '" + dir.string() + "': " +
-                       (error ? error.message() : "not a directory"));
+      throw UsageError("cannot write the results into '" + dir.string() +
+                       "': " + (error ? error.message() : "not a directory"));
   }
   if (fs::is_directory(file)) throw UsageError("'" + path + "' is a directory, not a JSON file");
   const bool existed = fs::exists(file);
@@ -572,7 +588,7 @@ void check_writable(const std::string& path) {
 // The plots ./tutorial.sh bench (scripts/plot_results.py) makes of a run, in its folder: a new
 // run there removes the last run's, so that the folder never shows plots of another run.
 constexpr std::array<const char*, 4> kRunPlots = {"phases.png", "speedup.png", "allocations.png",
-                                                 "solvers.png"};
+                                                  "solvers.png"};
 int remove_previous_plots(const std::string& json) {
   namespace fs = std::filesystem;
   int removed = 0;
@@ -594,7 +610,8 @@ int main(int argc, char** argv) {
   args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
   args.option("warmup", "N",
-              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)", "10");
+              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)",
+              "10");
   args.option("out", "DIR",
               "the run's folder: writes DIR/bench.json and removes the last run's plots there",
               "results");
@@ -612,8 +629,9 @@ int main(int argc, char** argv) {
     const int steps = args.get_int("steps"), warmup = args.get_int("warmup");
     if (steps <= 0) throw UsageError("--steps must be positive");
     if (warmup < 1)
-      throw UsageError("--warmup must be >= 1: the first step allocates the stepper's buffers, and "
-                       "the allocations per step are those of the steps after it");
+      throw UsageError(
+          "--warmup must be >= 1: the first step allocates the stepper's buffers, and "
+          "the allocations per step are those of the steps after it");
     const SolverSettings solver = solver_from_args(args);
     const std::vector<int> thread_counts = parse_thread_counts(args.get("threads"));
     const std::string path = json_path(args);
@@ -641,13 +659,15 @@ int main(int argc, char** argv) {
               << (others_now < 0 ? std::string("?") : std::to_string(others_now).substr(0, 4))
               << " of " << hardware_threads() << " cores now\n";
     if (others_now > std::max(LoadMonitor::kBusyCores, 0.1 * hardware_threads()))
-      std::cout << "  note: the machine is busy; the times will show it, threads that wait for each "
-                   "other at barriers most (the JSON and the plots record it)\n";
+      std::cout
+          << "  note: the machine is busy; the times will show it, threads that wait for each "
+             "other at barriers most (the JSON and the plots record it)\n";
     if (!alloc::enabled()) std::cout << "(allocation counting is off in this build)\n";
 
     LoadMonitor load;
     std::cout << "running " << selected.size() << " chapters interleaved, one step each in turn\n";
-    const std::vector<ChapterResult> results = run_chapters(selected, scene, solver, thread_counts, warmup, steps);
+    const std::vector<ChapterResult> results =
+        run_chapters(selected, scene, solver, thread_counts, warmup, steps);
     print_table(results);
     std::vector<SolverResult> solvers;
     if (!args.has_flag("no-solvers")) {

@@ -38,8 +38,9 @@ std::vector<Found> course_lessons() {
 std::string usage() {
   std::string out = "usage: fem_lessons [LESSON [--chapter ID] [options]]\n";
   for (const Found& f : course_lessons())
-    out += "  " + f.lesson.name + std::string(std::max<int>(1, 17 - int(f.lesson.name.size())), ' ') +
-           "chapter " + f.chapter->id.substr(0, 2) + ": " + f.lesson.summary + "\n";
+    out += "  " + f.lesson.name +
+           std::string(std::max<int>(1, 17 - int(f.lesson.name.size())), ' ') + "chapter " +
+           f.chapter->id.substr(0, 2) + ": " + f.lesson.summary + "\n";
   return out + "without a lesson: every lesson in turn, with its defaults\n";
 }
 
@@ -65,10 +66,11 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
-      << ",\n  \"chapter\": " << json_string(chapter.id) << ",\n  \"readme\": "
-      << json_string("chapters/" + chapter.id + "/README.md") << ",\n  \"marker\": "
-      << json_string(lesson.name + "-table") << ",\n  \"command\": " << json_string(command)
-      << ",\n  \"table\": " << json_string(table) << "\n}\n";
+      << ",\n  \"chapter\": " << json_string(chapter.id)
+      << ",\n  \"readme\": " << json_string("chapters/" + chapter.id + "/README.md")
+      << ",\n  \"marker\": " << json_string(lesson.name + "-table")
+      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table)
+      << "\n}\n";
 }
 
 // Fails before the work when the JSON cannot be written there.
@@ -76,7 +78,8 @@ void check_writable(const std::string& path) {
   const std::filesystem::path dir = std::filesystem::path(path).parent_path();
   if (!dir.empty() && !std::filesystem::is_directory(dir))
     throw UsageError("--json " + path + ": no directory " + dir.string());
-  if (!std::ofstream(path, std::ios::app)) throw UsageError("--json " + path + ": cannot write there");
+  if (!std::ofstream(path, std::ios::app))
+    throw UsageError("--json " + path + ": cannot write there");
 }
 
 // The lesson's table, on one thread unless the lesson measures threads; a run on a busy
@@ -116,7 +119,8 @@ int run_lesson(const Found& found, int argc, char** argv) {
     std::vector<std::pair<const ChapterInfo*, Lesson>> runs = {{found.chapter, found.lesson}};
     if (const std::string& id = args.get("chapter"); !id.empty()) {
       const ChapterInfo& variant = find_chapter(id);
-      if (variant.id != found.chapter->id) runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
+      if (variant.id != found.chapter->id)
+        runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
     }
     const std::string& readme = args.get("readme");
     const std::string& json = args.get("json");

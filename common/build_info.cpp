@@ -1,12 +1,12 @@
 #include "common/build_info.hpp"
 
-#include "common/json.hpp"
-
 #include <Eigen/Core>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <thread>
+
+#include "common/json.hpp"
 
 namespace fem {
 

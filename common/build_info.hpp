@@ -24,9 +24,10 @@ unsigned hardware_threads();
 // uncommitted_sources() lists changed and untracked files under the measured sources
 // (chapters/, common/, apps/, CMakeLists.txt; git status --porcelain --untracked-files=all).
 struct SourceState {
-  std::string commit;                     // with "-dirty" appended when uncommitted is not empty
-  std::vector<std::string> uncommitted;   // paths relative to the repository, e.g. "chapters/10_mine/stepper.cpp"
-  bool known = false;                     // false outside a git checkout (no git, a tarball)
+  std::string commit;  // with "-dirty" appended when uncommitted is not empty
+  std::vector<std::string>
+      uncommitted;     // paths relative to the repository, e.g. "chapters/10_mine/stepper.cpp"
+  bool known = false;  // false outside a git checkout (no git, a tarball)
 };
 SourceState source_state();
 // The JSON fields "commit": ..., "uncommitted": [...] (null when unknown).

@@ -14,7 +14,9 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-void progress(const std::string& what) { std::cerr << "  fem_lessons: " << what << "\n" << std::flush; }
+void progress(const std::string& what) {
+  std::cerr << "  fem_lessons: " << what << "\n" << std::flush;
+}
 
 std::string code(const std::string& s) {
   std::string out = "`";

@@ -75,9 +75,7 @@ void LoadMonitor::stop() {
   other_cpus_ = std::max(0.0, others / wall);
 }
 
-bool LoadMonitor::busy() const {
-  return other_cpus_ > std::max(kBusyCores, 0.1 * cores_);
-}
+bool LoadMonitor::busy() const { return other_cpus_ > std::max(kBusyCores, 0.1 * cores_); }
 
 std::string LoadMonitor::warning() const {
   if (!busy()) return "";
@@ -89,8 +87,8 @@ std::string LoadMonitor::warning() const {
 
 std::string LoadMonitor::json_fields() const {
   std::ostringstream out;
-  out << "\"load_average\": [" << load_before_ << ", " << load_after_ << "], \"other_cpus\": "
-      << (other_cpus_ < 0.0 ? std::string("null") : number(other_cpus_))
+  out << "\"load_average\": [" << load_before_ << ", " << load_after_
+      << "], \"other_cpus\": " << (other_cpus_ < 0.0 ? std::string("null") : number(other_cpus_))
       << ", \"busy\": " << (busy() ? "true" : "false");
   return out.str();
 }

@@ -135,7 +135,8 @@ TetMesh load_mesh(const std::string& path) {
   // chapter 11). A mesh gmsh generated lists them in tag order already.
   std::vector<std::size_t> by_tag(node_tags.size());
   std::iota(by_tag.begin(), by_tag.end(), std::size_t{0});
-  std::sort(by_tag.begin(), by_tag.end(), [&](std::size_t a, std::size_t b) { return node_tags[a] < node_tags[b]; });
+  std::sort(by_tag.begin(), by_tag.end(),
+            [&](std::size_t a, std::size_t b) { return node_tags[a] < node_tags[b]; });
   std::unordered_map<std::size_t, int> index_of_tag;
   index_of_tag.reserve(node_tags.size());
   Eigen::Matrix3Xd X(3, static_cast<Eigen::Index>(node_tags.size()));

@@ -1,11 +1,11 @@
 #include "common/stepper.hpp"
 
-#include "common/threads.hpp"
-
 #include <cmath>
 #include <iostream>
 #include <stdexcept>
 #include <string>
+
+#include "common/threads.hpp"
 
 namespace fem {
 

@@ -188,8 +188,7 @@ inline void check_damping_rate(const std::string& chapter) {
     stepper->step(state);
     expected *= rate;
     Eigen::VectorXd v_expected(state.v.size());
-    for (int i = 0; i < scene.mesh.num_nodes(); ++i)
-      v_expected.segment<3>(3 * i) = expected * v0;
+    for (int i = 0; i < scene.mesh.num_nodes(); ++i) v_expected.segment<3>(3 * i) = expected * v0;
     INFO(chapter << " step " << k + 1 << ": expected speed factor " << expected);
     CHECK((state.v - v_expected).cwiseAbs().maxCoeff() <= 1e-10 * v0.norm());
   }
@@ -207,9 +206,8 @@ inline void check_drift_at_default_tolerance(const std::string& chapter) {
   const Scene scene = driven_scene();
   const Drift d = drift_from_ch01(chapter, scene, kDefaultToleranceSteps, SolverSettings{});
   INFO(chapter << " at tolerance " << SolverSettings{}.tolerance << " over "
-               << kDefaultToleranceSteps << " steps: max |dx| " << d.x << " of motion "
-               << d.motion << ", max |dv| " << d.v << " of speed " << d.speed << ", relative "
-               << d.relative());
+               << kDefaultToleranceSteps << " steps: max |dx| " << d.x << " of motion " << d.motion
+               << ", max |dv| " << d.v << " of speed " << d.speed << ", relative " << d.relative());
   REQUIRE(d.motion > 1e-3);
   CHECK(d.relative() < kDefaultToleranceDrift);
 }
@@ -226,16 +224,15 @@ inline void check_drift_at_default_tolerance(const std::string& chapter) {
 // The tests every chapter after 01 runs, generic over the chapter: equivalence with chapter
 // 01 on every scene (the driven one included), the damping rate, and the drift at the
 // default tolerance. A new chapter's test file starts with FEM_CHAPTER_TESTS("NN", "[chNN]").
-#define FEM_CHAPTER_TESTS(ID, TAG)                                                            \
-  TEST_CASE("ch" ID ": matches chapter 01 on the cantilever, sliding and driven scenes", TAG) { \
-    fem::test::check_matches_ch01_on_every_scene(ID);                                         \
-  }                                                                                           \
-  TEST_CASE("ch" ID ": mass damping slows a rigid translation by 1/(1 + h alpha) per step",   \
-            TAG) {                                                                            \
-    fem::test::check_damping_rate(ID);                                                        \
-  }                                                                                           \
-  TEST_CASE("ch" ID ": drift from chapter 01 at the default tolerance stays bounded", TAG) {  \
-    fem::test::check_drift_at_default_tolerance(ID);                                          \
+#define FEM_CHAPTER_TESTS(ID, TAG)                                                                 \
+  TEST_CASE("ch" ID ": matches chapter 01 on the cantilever, sliding and driven scenes", TAG) {    \
+    fem::test::check_matches_ch01_on_every_scene(ID);                                              \
+  }                                                                                                \
+  TEST_CASE("ch" ID ": mass damping slows a rigid translation by 1/(1 + h alpha) per step", TAG) { \
+    fem::test::check_damping_rate(ID);                                                             \
+  }                                                                                                \
+  TEST_CASE("ch" ID ": drift from chapter 01 at the default tolerance stays bounded", TAG) {       \
+    fem::test::check_drift_at_default_tolerance(ID);                                               \
   }
 
 #include <random>
@@ -262,7 +259,8 @@ class JumpingMouse {
   std::vector<ExternalForce> force(int k, const State& state) {
     if (k % hold_ == 0) {
       node_ = surface_[pick_(random_)];
-      target_ = X_.col(node_) + Eigen::Vector3d(offset_(random_), offset_(random_), offset_(random_));
+      target_ =
+          X_.col(node_) + Eigen::Vector3d(offset_(random_), offset_(random_), offset_(random_));
     }
     return {{node_, stiffness_ * (target_ - state.x.segment<3>(3 * node_))}};
   }

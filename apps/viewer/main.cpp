@@ -375,8 +375,8 @@ int main(int argc, char** argv) {
     settings.solver = solver_from_args(args);
     auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
     std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
-              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", "
-              << threads << " threads for the parallel chapters\n";
+              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", " << threads
+              << " threads for the parallel chapters\n";
 
     const Window window(options);
     run(window.handle, session, options);

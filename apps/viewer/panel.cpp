@@ -53,7 +53,8 @@ void phase_bars(const Session& session) {
   // The graph's scale: 0 at the bottom, `top` at the top.
   const float top = 1.2f * highest + 1e-3f;
   ImGui::Text("step time of the last %d steps (0 to %.2f ms)", count, top);
-  ImGui::PlotLines("##step time", history, count, 0, nullptr, 0.0f, top, ImVec2(kPanelWidth - 20, 40));
+  ImGui::PlotLines("##step time", history, count, 0, nullptr, 0.0f, top,
+                   ImVec2(kPanelWidth - 20, 40));
   ImGui::Text("CG: %d iterations, residual %.1e", session.last_profile().cg_iterations,
               session.last_profile().relative_residual);
   if (!session.last_profile().converged)

@@ -5,7 +5,6 @@
 // Written the way Eigen's documentation suggests, without thinking about memory.
 #include "chapters/01_naive/stepper.hpp"
 
-
 namespace fem::ch01 {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;

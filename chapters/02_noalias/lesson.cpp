@@ -1,4 +1,5 @@
-// Chapter 02's lesson table: `fem_lessons noalias` (heap allocations of each vector statement, before and after).
+// Chapter 02's lesson table: `fem_lessons noalias` (heap allocations of each vector statement,
+// before and after).
 #include "chapters/02_noalias/lesson.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -26,11 +27,12 @@ std::string noalias_table(const Scene& scene) {
   return out.str();
 }
 
-
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {{"noalias", "allocations of each vector statement of chapter 01 and its chapter 02 rewrite", "meshes/test_beam.msh", nullptr,
+  return {{"noalias",
+           "allocations of each vector statement of chapter 01 and its chapter 02 rewrite",
+           "meshes/test_beam.msh", nullptr,
            [](const LessonRun& run) { return noalias_table(run.scene); }}};
 }
 

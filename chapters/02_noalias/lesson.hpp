@@ -1,4 +1,5 @@
-// The measurement behind chapter 02's lesson table: `fem_lessons noalias`, heap allocations of each vector statement, before and after.
+// The measurement behind chapter 02's lesson table: `fem_lessons noalias`, heap allocations of each
+// vector statement, before and after.
 #pragma once
 
 #include <vector>

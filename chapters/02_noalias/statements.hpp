@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "chapters/01_naive/stepper.hpp"
-#include "common/model.hpp"
 #include "common/alloc_counter.hpp"
+#include "common/model.hpp"
 
 namespace fem::ch02 {
 

@@ -5,7 +5,6 @@
 // Chapter 02 changes only the vector statements: none of them allocates any more.
 #include "chapters/02_noalias/stepper.hpp"
 
-
 namespace fem::ch02 {
 
 using SparseMatrix = Eigen::SparseMatrix<double>;

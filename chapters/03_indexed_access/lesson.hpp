@@ -1,4 +1,5 @@
-// The measurement behind chapter 03's lesson table: `fem_lessons dfdx-fill`, df/dx construction by coeffRef, by setFromTriplets, by the table.
+// The measurement behind chapter 03's lesson table: `fem_lessons dfdx-fill`, df/dx construction by
+// coeffRef, by setFromTriplets, by the table.
 #pragma once
 
 #include <vector>

@@ -87,8 +87,7 @@ void IndexedAccessStepper::build_block_offsets() {
     }
   }
   if (!block_offsets_match_pattern())
-    throw std::logic_error(
-        "03_indexed_access: the block offset table does not match the pattern");
+    throw std::logic_error("03_indexed_access: the block offset table does not match the pattern");
 }
 
 bool IndexedAccessStepper::block_offsets_match_pattern() const {

@@ -1,4 +1,5 @@
-// The measurement behind chapter 04's lesson table: `fem_lessons compose`, the heap allocations of chapter 03's sparse sums, cause by cause.
+// The measurement behind chapter 04's lesson table: `fem_lessons compose`, the heap allocations of
+// chapter 03's sparse sums, cause by cause.
 #pragma once
 
 #include <vector>

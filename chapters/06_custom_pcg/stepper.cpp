@@ -87,8 +87,7 @@ void CustomPcgStepper::build_block_offsets() {
     }
   }
   if (!block_offsets_match_pattern())
-    throw std::logic_error(
-        "06_custom_pcg: the block offset table does not match the pattern");
+    throw std::logic_error("06_custom_pcg: the block offset table does not match the pattern");
 }
 
 bool CustomPcgStepper::block_offsets_match_pattern() const {
@@ -252,9 +251,9 @@ void filter(const std::vector<NodeConstraint>& constraints, Eigen::VectorXd& v) 
 }  // namespace
 
 SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
-                    const std::vector<NodeConstraint>& constraints,
-                    const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
-                    PcgWorkspace& work, Eigen::VectorXd& y) {
+                     const std::vector<NodeConstraint>& constraints,
+                     const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
+                     PcgWorkspace& work, Eigen::VectorXd& y) {
   const Eigen::Index n = b.size();
   auto& [r, s, p, q, inverse_diagonal] = work;
   // Same sizes every step: these resizes allocate on the first solve only.

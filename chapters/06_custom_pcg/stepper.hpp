@@ -26,9 +26,9 @@ struct PcgWorkspace {
 // in each iteration, so the iterates stay in the constrained subspace (Tamstorf et al.
 // 2015). diagonal_offsets[k] is where entry (k, k) of A sits in A.valuePtr().
 SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
-                    const std::vector<NodeConstraint>& constraints,
-                    const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
-                    PcgWorkspace& work, Eigen::VectorXd& y);
+                     const std::vector<NodeConstraint>& constraints,
+                     const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
+                     PcgWorkspace& work, Eigen::VectorXd& y);
 
 // Where each diagonal entry sits in the value array of a compressed matrix.
 std::vector<int> diagonal_offsets(const Eigen::SparseMatrix<double>& A);

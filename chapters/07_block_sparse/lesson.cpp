@@ -1,4 +1,5 @@
-// Chapter 07's lesson table: `fem_lessons spmv` (SpMV by Eigen (both storage orders) and by 3x3 blocks (full and symmetric storage), and block Jacobi against scalar Jacobi in the PCG).
+// Chapter 07's lesson table: `fem_lessons spmv` (SpMV by Eigen (both storage orders) and by 3x3
+// blocks (full and symmetric storage), and block Jacobi against scalar Jacobi in the PCG).
 #include "chapters/07_block_sparse/lesson.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -56,7 +57,8 @@ std::string spmv_row(const std::string& what, double ms, double reference_ms, do
 }
 
 // y = A x by Eigen's three products and by the blocks, full and symmetric storage.
-std::string spmv_rows(const BlockSparseMatrix& A, const Eigen::SparseMatrix<double>& csc, int repeat) {
+std::string spmv_rows(const BlockSparseMatrix& A, const Eigen::SparseMatrix<double>& csc,
+                      int repeat) {
   const BlockSparseMatrix upper_A = upper(A);
   const Eigen::VectorXd x = Eigen::VectorXd::Ones(csc.cols());
   Eigen::VectorXd y(x.size());
@@ -69,7 +71,9 @@ std::string spmv_rows(const BlockSparseMatrix& A, const Eigen::SparseMatrix<doub
   const double block_upper = time_ms(repeat, [&] { multiply_upper(upper_A, x, y); });
   // Index memory: CSC stores one row index per entry and one pointer per column; BSR one
   // column index per block and one pointer per block row.
-  const auto kib = [](std::size_t ints) { return static_cast<double>(ints * sizeof(int)) / 1024.0; };
+  const auto kib = [](std::size_t ints) {
+    return static_cast<double>(ints * sizeof(int)) / 1024.0;
+  };
   const double csc_kib = kib(csc.nonZeros() + csc.cols() + 1);
   return "| SpMV, y = A x | median ms | vs Eigen column-major | index memory (KiB) |\n"
          "| --- | ---: | ---: | ---: |\n" +
@@ -111,8 +115,7 @@ std::string pcg_rows(const BlockSparseStepper& stepper, const Eigen::SparseMatri
       << "| PCG from zero, same system and tolerance | median ms | iterations |\n"
       << "| --- | ---: | ---: |\n"
       << "| scalar Jacobi on CSC (chapter 06) | " << pcg6 << " | " << r6.iterations << " |\n"
-      << "| block Jacobi on 3x3 blocks (chapter 07) | " << pcg7 << " | " << r7.iterations
-      << " |\n";
+      << "| block Jacobi on 3x3 blocks (chapter 07) | " << pcg7 << " | " << r7.iterations << " |\n";
   return out.str();
 }
 
@@ -139,7 +142,8 @@ std::string spmv_table(const Scene& scene, int steps) {
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {{"spmv", "SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi", "meshes/plate_poster.msh", nullptr,
+  return {{"spmv", "SpMV: Eigen against 3x3 blocks; PCG: scalar against block Jacobi",
+           "meshes/plate_poster.msh", nullptr,
            [](const LessonRun& run) { return spmv_table(run.scene, run.steps); }}};
 }
 

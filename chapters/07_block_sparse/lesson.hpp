@@ -1,4 +1,6 @@
-// The measurement behind chapter 07's lesson table: `fem_lessons spmv`, SpMV by Eigen (both storage orders) and by 3x3 blocks (full and symmetric storage), and block Jacobi against scalar Jacobi in the PCG.
+// The measurement behind chapter 07's lesson table: `fem_lessons spmv`, SpMV by Eigen (both storage
+// orders) and by 3x3 blocks (full and symmetric storage), and block Jacobi against scalar Jacobi in
+// the PCG.
 #pragma once
 
 #include <vector>

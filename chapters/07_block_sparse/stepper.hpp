@@ -37,14 +37,14 @@ class BlockSparseStepper final : public Stepper {
   StepProfile profile_;
   bool warned_not_converged_ = false;
 
-  std::vector<Eigen::Matrix3d> rotations_;           // R_e of the polar decomposition, per element
-  Eigen::VectorXd f_;                                // elastic forces + gravity
-  BlockSparseMatrix dfdx_;                           // pattern of the mesh connectivity, built once
-  BlockIndex index_;                                 // where element, diagonal and transposed blocks sit
-  BlockSparseMatrix A_;                              // M - h df/dv - h^2 df/dx, the pattern of dfdx_
-  Eigen::VectorXd b_;                 // h (f + f_ext + df/dv v + h df/dx v)
-  Eigen::VectorXd z_;                 // prescribed velocity change of constrained dofs
-  Eigen::VectorXd filtered_b_;        // S (b - A z)
+  std::vector<Eigen::Matrix3d> rotations_;  // R_e of the polar decomposition, per element
+  Eigen::VectorXd f_;                       // elastic forces + gravity
+  BlockSparseMatrix dfdx_;                  // pattern of the mesh connectivity, built once
+  BlockIndex index_;                        // where element, diagonal and transposed blocks sit
+  BlockSparseMatrix A_;                     // M - h df/dv - h^2 df/dx, the pattern of dfdx_
+  Eigen::VectorXd b_;                       // h (f + f_ext + df/dv v + h df/dx v)
+  Eigen::VectorXd z_;                       // prescribed velocity change of constrained dofs
+  Eigen::VectorXd filtered_b_;              // S (b - A z)
   Eigen::VectorXd dv_;
   Eigen::VectorXd scaled_v_;  // (h + beta) v, the vector df/dx multiplies in b
   PcgWorkspace pcg_;

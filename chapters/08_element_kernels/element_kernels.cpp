@@ -102,8 +102,8 @@ Eigen::Matrix<double, 3, 4> rotated_gradients(const Eigen::Matrix3d& R,
   return r;
 }
 
-void stiffness_blocks(const Eigen::Matrix<double, 3, 4>& r, double mu_volume,
-                      double lambda_volume, std::array<Eigen::Matrix3d, 10>& K) {
+void stiffness_blocks(const Eigen::Matrix<double, 3, 4>& r, double mu_volume, double lambda_volume,
+                      std::array<Eigen::Matrix3d, 10>& K) {
   for (std::size_t p = 0; p < kUpperPairs.size(); ++p) {
     const auto ra = r.col(kUpperPairs[p][0]), rb = r.col(kUpperPairs[p][1]);
     // One outer product serves both rank-one terms: r_b r_a^T and its transpose.
@@ -127,8 +127,8 @@ FusedElements::FusedElements(const Model& model, const Scene& scene)
   previous_rotations_ = rotations_;
 }
 
-void FusedElements::terms(int e, const Eigen::Vector4i& t, const State& state,
-                          long long& fallbacks, ElementTerms& out) {
+void FusedElements::terms(int e, const Eigen::Vector4i& t, const State& state, long long& fallbacks,
+                          ElementTerms& out) {
   const ElementShape& shape = shapes_[e];
   Eigen::Matrix3d Ds, Dv;  // edge vectors of positions and velocities
   for (int i = 0; i < 3; ++i) {

@@ -52,8 +52,8 @@ Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond
 // The scale s multiplies both Lame terms (the fused pass passes h beta + h^2).
 constexpr std::array<std::array<int, 2>, 10> kUpperPairs = {
     {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1}, {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}}};
-void stiffness_blocks(const Eigen::Matrix<double, 3, 4>& r, double mu_volume,
-                      double lambda_volume, std::array<Eigen::Matrix3d, 10>& K);
+void stiffness_blocks(const Eigen::Matrix<double, 3, 4>& r, double mu_volume, double lambda_volume,
+                      std::array<Eigen::Matrix3d, 10>& K);
 
 // r_a = R g_a, the rotated shape gradients, for a = 0..3.
 Eigen::Matrix<double, 3, 4> rotated_gradients(const Eigen::Matrix3d& R,

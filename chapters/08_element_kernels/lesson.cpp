@@ -1,4 +1,5 @@
-// Chapter 08's lesson table: `fem_lessons rotations` (per element, the rotation by JacobiSVD and by Newton (cold and warm-started), the element blocks from a stored K0 and in closed form).
+// Chapter 08's lesson table: `fem_lessons rotations` (per element, the rotation by JacobiSVD and by
+// Newton (cold and warm-started), the element blocks from a stored K0 and in closed form).
 #include "chapters/08_element_kernels/lesson.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -40,10 +41,14 @@ ElementSample sample_step(const Scene& scene) {
   ElementKernelsStepper stepper(scene, {});
   State state = rest_state(scene);
   for (int k = 0; k < 20; ++k) stepper.step(state);
-  ElementSample sample{Model(scene), {}, stepper.elements().rotations(),
-                       stepper.elements().previous_rotations(), stepper.elements().shapes()};
+  ElementSample sample{Model(scene),
+                       {},
+                       stepper.elements().rotations(),
+                       stepper.elements().previous_rotations(),
+                       stepper.elements().shapes()};
   for (std::size_t e = 0; e < sample.model.tets.size(); ++e)
-    sample.F.push_back(deformation_gradient(sample.model.rest[e], gather(state.x, sample.model.tets[e])));
+    sample.F.push_back(
+        deformation_gradient(sample.model.rest[e], gather(state.x, sample.model.tets[e])));
   return sample;
 }
 
@@ -60,7 +65,8 @@ struct NewtonCount {
   }
 };
 
-std::string table_row(const std::string& what, double ns, double reference_ns, const std::string& last) {
+std::string table_row(const std::string& what, double ns, double reference_ns,
+                      const std::string& last) {
   std::ostringstream row;
   row << std::fixed << "| " << what << " | " << std::setprecision(1) << ns << " | "
       << std::setprecision(2) << reference_ns / ns << "x | " << last << " |\n";
@@ -87,38 +93,44 @@ std::string rotation_rows(const ElementSample& s, int repeat, std::vector<Eigen:
   const double to_ns = 1e6 / static_cast<double>(m);  // median ms of a sweep -> ns/element
   R.resize(m);
   const double svd = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(s.F[e]);
-  });
+                       for (std::size_t e = 0; e < m; ++e) R[e] = polar_rotation(s.F[e]);
+                     });
   const double eigensolver = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) R[e] = polar_by_eigensolver(s.F[e]);
-  });
+                               for (std::size_t e = 0; e < m; ++e)
+                                 R[e] = polar_by_eigensolver(s.F[e]);
+                             });
   NewtonCount cold, warm, predicted;
   const auto identity = [](std::size_t) { return Eigen::Quaterniond::Identity(); };
   const auto last = [&](std::size_t e) { return s.previous[e]; };
-  const auto extrapolated = [&](std::size_t e) { return predicted_rotation(s.previous[e], s.before[e]); };
+  const auto extrapolated = [&](std::size_t e) {
+    return predicted_rotation(s.previous[e], s.before[e]);
+  };
   const double cold_ns = newton_ns(s, repeat, identity, cold);
   const double warm_ns = newton_ns(s, repeat, last, warm);
   const double predicted_ns = newton_ns(s, repeat, extrapolated, predicted);
   long long fallbacks = 0;
   const double fast = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) {
-      Eigen::Quaterniond q = extrapolated(e);
-      R[e] = fast_polar_rotation(s.F[e], q, fallbacks);
-    }
-  });
+                        for (std::size_t e = 0; e < m; ++e) {
+                          Eigen::Quaterniond q = extrapolated(e);
+                          R[e] = fast_polar_rotation(s.F[e], q, fallbacks);
+                        }
+                      });
   difference = 0.0;  // the answers, against common/'s
   for (std::size_t e = 0; e < m; ++e)
     difference = std::max(difference, (R[e] - polar_rotation(s.F[e])).cwiseAbs().maxCoeff());
   return "| rotation of one element | ns per element | vs JacobiSVD | iterations |\n"
          "| --- | ---: | ---: | ---: |\n" +
          table_row("`JacobiSVD<Matrix3d>`, U V^T (common/, chapters 01-07)", svd, svd, "-") +
-         table_row("`SelfAdjointEigenSolver::computeDirect` of F^T F (no inversion, squared "
-                   "condition)", eigensolver, svd, "-") +
+         table_row(
+             "`SelfAdjointEigenSolver::computeDirect` of F^T F (no inversion, squared "
+             "condition)",
+             eigensolver, svd, "-") +
          table_row("Newton, cold (from the identity)", cold_ns, svd, cold.mean(m)) +
          table_row("Newton, warm (from the previous step's rotation)", warm_ns, svd, warm.mean(m)) +
          table_row("Newton, warm (predicted from the last two steps' rotations)", predicted_ns, svd,
                    predicted.mean(m)) +
-         table_row("predicted start, Newton, SVD fallback: the stepper's (chapter 08)", fast, svd, "-");
+         table_row("predicted start, Newton, SVD fallback: the stepper's (chapter 08)", fast, svd,
+                   "-");
 }
 
 // The element blocks: sixteen -R K0_ab R^T from the stored K0 (chapter 07), against the ten
@@ -128,17 +140,18 @@ std::string block_rows(const ElementSample& s, const std::vector<Eigen::Matrix3d
   const double to_ns = 1e6 / static_cast<double>(m);
   Eigen::Matrix3d sink = Eigen::Matrix3d::Zero();  // keeps the blocks from being optimized out
   const double stored = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e)
-      for (int ab = 0; ab < 16; ++ab) sink += dfdx_block(s.model.rest[e], R[e], ab / 4, ab % 4);
-  });
+                          for (std::size_t e = 0; e < m; ++e)
+                            for (int ab = 0; ab < 16; ++ab)
+                              sink += dfdx_block(s.model.rest[e], R[e], ab / 4, ab % 4);
+                        });
   std::array<Eigen::Matrix3d, 10> K;
   const double closed = to_ns * time_ms(repeat, [&] {
-    for (std::size_t e = 0; e < m; ++e) {
-      stiffness_blocks(rotated_gradients(R[e], s.shapes[e].Dm_inv), s.shapes[e].mu_volume,
-                       s.shapes[e].lambda_volume, K);
-      for (const Eigen::Matrix3d& k : K) sink += k;
-    }
-  });
+                          for (std::size_t e = 0; e < m; ++e) {
+                            stiffness_blocks(rotated_gradients(R[e], s.shapes[e].Dm_inv),
+                                             s.shapes[e].mu_volume, s.shapes[e].lambda_volume, K);
+                            for (const Eigen::Matrix3d& k : K) sink += k;
+                          }
+                        });
   volatile double keep = sink.sum();
   (void)keep;
   const auto rest_data = [m](std::size_t bytes) {
@@ -192,7 +205,9 @@ std::string rotations_table(const Scene& bench_scene, int steps) {
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {{"rotations", "per element: rotation by SVD and by Newton; blocks from K0 and closed form", "meshes/plate_poster.msh", nullptr,
+  return {{"rotations",
+           "per element: rotation by SVD and by Newton; blocks from K0 and closed form",
+           "meshes/plate_poster.msh", nullptr,
            [](const LessonRun& run) { return rotations_table(run.scene, run.steps); }}};
 }
 

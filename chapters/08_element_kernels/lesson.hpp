@@ -1,4 +1,6 @@
-// The measurement behind chapter 08's lesson table: `fem_lessons rotations`, per element, the rotation by JacobiSVD and by Newton (cold and warm-started), the element blocks from a stored K0 and in closed form.
+// The measurement behind chapter 08's lesson table: `fem_lessons rotations`, per element, the
+// rotation by JacobiSVD and by Newton (cold and warm-started), the element blocks from a stored K0
+// and in closed form.
 #pragma once
 
 #include <vector>

@@ -52,8 +52,8 @@ class ElementKernelsStepper : public Stepper {
   bool warned_not_converged_ = false;
 
   FusedElements elements_;
-  BlockSparseMatrix A_;  // M - h df/dv - h^2 df/dx, the mesh's block pattern
-  BlockIndex index_;     // where element, diagonal and transposed blocks sit in A_
+  BlockSparseMatrix A_;         // M - h df/dv - h^2 df/dx, the mesh's block pattern
+  BlockIndex index_;            // where element, diagonal and transposed blocks sit in A_
   Eigen::VectorXd b_;           // h (f + h df/dx v)
   Eigen::VectorXd z_;           // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;  // S (b - A z)

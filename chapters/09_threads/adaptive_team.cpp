@@ -9,7 +9,7 @@ int AdaptiveTeam::next(int given) {
   chosen_ = enabled_ && given > 1;
   probing_ = false;
   if (!chosen_) return team_ = given;  // nothing to choose: record() ignores this step
-  if (given != given_) {  // a new count from the program: start over with it
+  if (given != given_) {               // a new count from the program: start over with it
     given_ = current_ = given;
     period_ = until_probe_ = kFirstPeriod;
     recorded_ = 0;

@@ -35,20 +35,20 @@ class AdaptiveTeam {
 
  private:
   static constexpr int kWindow = 3, kFirstPeriod = 8, kMaxPeriod = 256;
-  static constexpr double kGain = 0.8;  // a probe must take at most 0.8 of the usual time
+  static constexpr double kGain = 0.8;    // a probe must take at most 0.8 of the usual time
   static constexpr double kChange = 1.5;  // a usual time 1.5 times up or down: probe now
-  double usual() const;                 // median of the window
+  double usual() const;                   // median of the window
 
   bool enabled_ = true;
-  int given_ = 0;    // the program's count when the window was filled
-  int current_ = 0;  // the team in use
-  int team_ = 0;     // the team of the step being run
+  int given_ = 0;         // the program's count when the window was filled
+  int current_ = 0;       // the team in use
+  int team_ = 0;          // the team of the step being run
   bool chosen_ = false;   // this step's team was chosen (enabled, more than one thread given)
   bool probing_ = false;  // this step is a probe of the other team
   int period_ = kFirstPeriod, until_probe_ = kFirstPeriod;
   double window_[kWindow] = {};
   double reference_ = 0.0;  // the usual time at the last decision
-  int recorded_ = 0;  // steps in the window since the last switch
+  int recorded_ = 0;        // steps in the window since the last switch
   int switches_ = 0;
 };
 

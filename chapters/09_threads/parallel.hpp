@@ -49,10 +49,9 @@ class StaticShare {
     begin_ = first + static_cast<int>(count * thread / threads);
     end_ = first + static_cast<int>(count * (thread + 1) / threads);
   }
-  ~StaticShare() {
+  ~StaticShare(){
 #pragma omp barrier
-  }
-  StaticShare(const StaticShare&) = delete;
+  } StaticShare(const StaticShare&) = delete;
   StaticShare& operator=(const StaticShare&) = delete;
 
   struct Iterator {

@@ -40,7 +40,8 @@ double sum_in_order(const std::vector<double>& partial) {
 void Preconditioner::apply_rows(int, int, const Eigen::VectorXd&, Eigen::VectorXd&) const {}
 
 void Preconditioner::apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-  for (const int c : StaticShare(chunks.count())) apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
+  for (const int c : StaticShare(chunks.count()))
+    apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
 }
 
 BlockJacobi::BlockJacobi(const std::vector<int>& diagonal_block)
@@ -66,8 +67,9 @@ ParallelPcg::ParallelPcg(const BlockSparseMatrix& pattern,
                          const std::vector<NodeConstraint>& constraints)
     : chunks_(pattern), constraints_(constraints) {  // a copy: no reference into a scene
   // The constraints of each chunk, in node order.
-  std::stable_sort(constraints_.begin(), constraints_.end(),
-                   [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+  std::stable_sort(
+      constraints_.begin(), constraints_.end(),
+      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
   constraint_start_.assign(chunks_.count() + 1, 0);
   for (int c = 0, k = 0; c < chunks_.count(); ++c) {
     while (k < static_cast<int>(constraints_.size()) && constraints_[k].node < chunks_.start[c + 1])
@@ -101,7 +103,8 @@ SolveStats ParallelPcg::iterate(const BlockSparseMatrix& A, Preconditioner& M,
                                 const SolverSettings& settings, Eigen::VectorXd& y) {
   SolveStats stats;
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
-    for (const int c : StaticShare(chunks_.count())) y.segment(chunks_.first_dof(c), chunks_.dofs(c)).setZero();
+    for (const int c : StaticShare(chunks_.count()))
+      y.segment(chunks_.first_dof(c), chunks_.dofs(c)).setZero();
     stats.converged = true;
     return stats;
   }

@@ -86,7 +86,7 @@ class ParallelPcg {
                      double rhs_norm2, const SolverSettings& settings, Eigen::VectorXd& y);
   double filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y);  // S y; ||b||^2
   double residual(const BlockSparseMatrix& A, const Preconditioner& M, const Eigen::VectorXd& b,
-                  const Eigen::VectorXd& y);              // r = S (b - A y); ||r||^2
+                  const Eigen::VectorXd& y);                   // r = S (b - A y); ||r||^2
   double precondition(Preconditioner& M, Eigen::VectorXd& s);  // s = S M r; r . s
   double product(const BlockSparseMatrix& A);                  // q = A p; p . q
   double update(const Preconditioner& M, double step, Eigen::VectorXd& y);  // y, r; ||r||^2

@@ -129,10 +129,12 @@ void ThreadsStepper::build_gather_tables() {
   // element order, so that each sum adds in the serial pass's order.
   const int num_elements = static_cast<int>(model_.tets.size());
   element_terms_.resize(num_elements);
-  invert(model_.num_nodes, 4 * num_elements, [this](int t) { return model_.tets[t / 4][t % 4]; },
-         node_corner_start_, node_corners_);
-  invert(static_cast<int>(A_.blocks.size()), 16 * num_elements,
-         [this](int t) { return index_.element[t / 16][t % 16]; }, block_term_start_, block_terms_);
+  invert(
+      model_.num_nodes, 4 * num_elements, [this](int t) { return model_.tets[t / 4][t % 4]; },
+      node_corner_start_, node_corners_);
+  invert(
+      static_cast<int>(A_.blocks.size()), 16 * num_elements,
+      [this](int t) { return index_.element[t / 16][t % 16]; }, block_term_start_, block_terms_);
 }
 
 void ThreadsStepper::colour_element_groups(int group) {
@@ -141,8 +143,9 @@ void ThreadsStepper::colour_element_groups(int group) {
   group_ = std::max(1, group);
   const std::vector<int> colour = colour_groups(model_.tets, model_.num_nodes, group_);
   const int colours = colour.empty() ? 0 : 1 + *std::max_element(colour.begin(), colour.end());
-  invert(colours, static_cast<int>(colour.size()), [&colour](int g) { return colour[g]; },
-         colour_start_, colour_order_);
+  invert(
+      colours, static_cast<int>(colour.size()), [&colour](int g) { return colour[g]; },
+      colour_start_, colour_order_);
 }
 
 void ThreadsStepper::element_pass(const State& state) {
@@ -167,7 +170,8 @@ void ThreadsStepper::start_system(const State& state) {
       const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
       b_.segment(first, size).noalias() =
           h * model_.gravity_force.segment(first, size) -
-          (h * alpha) * model_.lumped_mass.segment(first, size).cwiseProduct(state.v.segment(first, size));
+          (h * alpha) *
+              model_.lumped_mass.segment(first, size).cwiseProduct(state.v.segment(first, size));
     }
   });
   b_ += h * f_ext_;  // a few nonzeros, added into a dense vector: not worth a thread

@@ -46,7 +46,8 @@ MultigridSettings multigrid_from_args(const ArgParser& args) {
   s.sweeps = args.get_int("sweeps");
   s.l1 = args.get("l1") != "off";
   s.extrapolation = args.get_int("extrapolate");
-  if (s.extrapolation < 0 || s.extrapolation > 2) throw UsageError("--extrapolate must be 0, 1 or 2");
+  if (s.extrapolation < 0 || s.extrapolation > 2)
+    throw UsageError("--extrapolate must be 0, 1 or 2");
   s.max_blocks = args.get_int("blocks");
   s.serial_rows = args.get_int("serial-rows");
   s.chebyshev_degree = args.get_int("degree");
@@ -66,7 +67,8 @@ MultigridSettings multigrid_from_args(const ArgParser& args) {
   if (s.sweeps < 1) throw UsageError("--sweeps must be at least 1");
   if (s.max_coarse_dofs < 6) throw UsageError("--max-coarse must be at least 6");
   if (s.max_blocks < 1 || s.chebyshev_degree < 1 || s.improve_candidates < 0 || s.serial_rows < 0)
-    throw UsageError("--blocks and --degree must be at least 1, --improve and --serial-rows 0 or more");
+    throw UsageError(
+        "--blocks and --degree must be at least 1, --improve and --serial-rows 0 or more");
   if (!(s.refresh_growth >= 0.0)) throw UsageError("--growth must be 0 (off) or more");
   if (args.get("l1") != "on" && args.get("l1") != "off") throw UsageError("--l1 must be on or off");
   return s;
@@ -158,8 +160,8 @@ Costs measure_costs(Multigrid& mg, const Eigen::VectorXd& b, int threads, long l
   c.v_cycle = team_ms(20, [&] { mg.apply(b, y); });
   double refresh = 0.0;
   for (const LevelCost& cost : c.level) refresh += cost.refresh;
-  c.prepare_per_step = c.level[0].between +
-                       (refresh - c.level[0].between) * static_cast<double>(refreshes) / steps;
+  c.prepare_per_step =
+      c.level[0].between + (refresh - c.level[0].between) * static_cast<double>(refreshes) / steps;
   return c;
 }
 
@@ -184,12 +186,13 @@ std::string cost_table(const Multigrid& mg, const std::vector<Costs>& costs, dou
     t << "\n";
   };
   for (int l = 0; l < mg.levels(); ++l) {
-    const std::string level = "level " + std::to_string(l) + " (" +
-                              std::to_string(mg.level_parts(l)) + " row blocks): ";
+    const std::string level =
+        "level " + std::to_string(l) + " (" + std::to_string(mg.level_parts(l)) + " row blocks): ";
     if (l == 0)
       row(level + "`prepare` between refreshes",
           [&](const Costs& c) { return ms_spmv(c.level[l].between, spmv); });
-    row(level + "`prepare` at a refresh", [&](const Costs& c) { return ms_spmv(c.level[l].refresh, spmv); });
+    row(level + "`prepare` at a refresh",
+        [&](const Costs& c) { return ms_spmv(c.level[l].refresh, spmv); });
     row(level + "its share of one V-cycle", [&](const Costs& c) {
       const double below = l + 1 < mg.levels() ? c.level[l + 1].cycle_from : 0.0;
       return ms_spmv(c.level[l].cycle_from - below, spmv);
@@ -305,8 +308,8 @@ std::string main_table(const LessonRun& run, const Multigrid& mg, const RunStats
                        const FromZero& z, const std::vector<Costs>& costs, double spmv) {
   std::ostringstream t;
   t << std::fixed << std::setprecision(1);
-  t << "| `" << mesh_name(run.scene) << "`, " << run.scene.name << ", " << run.steps
-    << " steps, " << max_threads() << " thread(s) | value |\n"
+  t << "| `" << mesh_name(run.scene) << "`, " << run.scene.name << ", " << run.steps << " steps, "
+    << max_threads() << " thread(s) | value |\n"
     << "| --- | ---: |\n";
   for (int l = 0; l < mg.levels(); ++l)
     t << "| level " << l << ": unknowns (stored blocks) | " << mg.level_dofs(l) << " ("
@@ -333,10 +336,10 @@ std::string multigrid_table(const LessonRun& run) {
   const SolverSettings solver = solver_from_args(args);
   const MultigridSettings settings = multigrid_from_args(args);
   const std::vector<int> counts = cost_thread_counts(args);
-  std::cerr << "fem_lessons multigrid: scene " << scene.name << ", mesh " << scene.mesh.file
-            << " (" << scene.mesh.num_nodes() << " nodes), " << run.steps << " steps, tol "
-            << solver.tolerance << ", smoother " << args.get("smoother") << ", "
-            << max_threads() << " thread(s)\n";
+  std::cerr << "fem_lessons multigrid: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
+            << scene.mesh.num_nodes() << " nodes), " << run.steps << " steps, tol "
+            << solver.tolerance << ", smoother " << args.get("smoother") << ", " << max_threads()
+            << " thread(s)\n";
   const auto setup_start = Clock::now();
   MultigridStepper stepper(scene, solver, settings);
   const double setup_ms = 1e3 * std::chrono::duration<double>(Clock::now() - setup_start).count();
@@ -371,9 +374,12 @@ std::string multigrid_table(const LessonRun& run) {
 
 const char* smoother_name(MultigridSettings::Smoother smoother) {
   switch (smoother) {
-    case MultigridSettings::Smoother::GaussSeidel: return "gs";
-    case MultigridSettings::Smoother::Chebyshev: return "chebyshev";
-    default: return "jacobi";
+    case MultigridSettings::Smoother::GaussSeidel:
+      return "gs";
+    case MultigridSettings::Smoother::Chebyshev:
+      return "chebyshev";
+    default:
+      return "jacobi";
   }
 }
 
@@ -386,7 +392,8 @@ void add_multigrid_options(ArgParser& args) {
     return s.str();
   };
   add_solver_options(args);
-  args.option("modes", "N", "near-null-space modes per aggregate: 6 or 3 (translations)", text(d.modes));
+  args.option("modes", "N", "near-null-space modes per aggregate: 6 or 3 (translations)",
+              text(d.modes));
   args.option("smoother", "NAME",
               "gs (l1-hybrid block Gauss-Seidel), chebyshev (on block Jacobi) or jacobi",
               smoother_name(d.smoother));
@@ -408,7 +415,9 @@ void add_multigrid_options(ArgParser& args) {
   args.option("prolongator", "KIND",
               "frozen (smoothed on the first step), every-step (smoothed at every refresh) or "
               "tentative (unsmoothed)",
-              d.update_prolongator ? "every-step" : d.smooth_prolongator ? "frozen" : "tentative");
+              d.update_prolongator   ? "every-step"
+              : d.smooth_prolongator ? "frozen"
+                                     : "tentative");
   args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns",
               text(d.max_coarse_dofs));
   args.option("coarse-every", "K", "recompute the coarse matrices every K-th step",

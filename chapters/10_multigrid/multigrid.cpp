@@ -4,7 +4,8 @@
 // smoother; at a refresh also P = (I - w D^-1 A) T (the first time), A_c = P^T A P, the
 // coarse smoothers and the coarsest Cholesky, numbers only. Every PCG iteration (apply): one
 // V-cycle. prepare and apply run on the whole team: every loop a StaticShare (chapter 09's
-// `omp for` written out) over fixed row blocks, each row written by one thread, every sum in a fixed order.
+// `omp for` written out) over fixed row blocks, each row written by one thread, every sum in a
+// fixed order.
 #include "chapters/10_multigrid/multigrid.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -41,8 +42,8 @@ std::vector<int> aggregate_nodes(const Rows& graph, int& count) {
   // 1: a node whose neighbours are all unaggregated seeds an aggregate with them.
   for (int i = 0; i < n; ++i) {
     if (aggregate[i] != -1) continue;
-    const bool free = std::all_of(graph[i].begin(), graph[i].end(),
-                                  [&](int j) { return aggregate[j] == -1; });
+    const bool free =
+        std::all_of(graph[i].begin(), graph[i].end(), [&](int j) { return aggregate[j] == -1; });
     if (!free) continue;
     for (const int j : graph[i]) aggregate[j] = count;
     aggregate[i] = count++;
@@ -165,9 +166,12 @@ void partition(Level<B>& level, const MultigridSettings& settings) {
   level.inner_end.resize(rows);
   for (int p = 0; p < count; ++p)
     for (int i = level.part[p]; i < level.part[p + 1]; ++i) {
-      const auto first = A.column.begin() + A.row_start[i], last = A.column.begin() + A.row_start[i + 1];
-      level.inner_begin[i] = static_cast<int>(std::lower_bound(first, last, level.part[p]) - A.column.begin());
-      level.inner_end[i] = static_cast<int>(std::lower_bound(first, last, level.part[p + 1]) - A.column.begin());
+      const auto first = A.column.begin() + A.row_start[i],
+                 last = A.column.begin() + A.row_start[i + 1];
+      level.inner_begin[i] =
+          static_cast<int>(std::lower_bound(first, last, level.part[p]) - A.column.begin());
+      level.inner_end[i] =
+          static_cast<int>(std::lower_bound(first, last, level.part[p + 1]) - A.column.begin());
     }
   level.serial = rows < settings.serial_rows;
 }
@@ -550,7 +554,8 @@ void gauss_seidel_from_zero(Level<B>& level, int first, int last, const Eigen::V
                             Eigen::VectorXd& x) {
   for (int i = first; i < last; ++i) {
     const Eigen::Matrix<double, B, 1> r =
-        b.template segment<B>(B * i) - row_product(level, x, level.inner_begin[i], level.diagonal[i]);
+        b.template segment<B>(B * i) -
+        row_product(level, x, level.inner_begin[i], level.diagonal[i]);
     x.template segment<B>(B * i).noalias() = level.inverse_diagonal[i] * r;
   }
 }
@@ -613,8 +618,8 @@ void polynomial_step(Level<B>& level, int k, int first, int last, const Eigen::V
 // l1 x minus the product of the blocks right of the diagonal and outside the block: the
 // sweep and the residual together read the matrix once.
 template <int B>
-void residual(Level<B>& level, bool after_one_sweep, int first, int last,
-              const Eigen::VectorXd& b, const Eigen::VectorXd& x) {
+void residual(Level<B>& level, bool after_one_sweep, int first, int last, const Eigen::VectorXd& b,
+              const Eigen::VectorXd& x) {
   const auto& A = level.A;
   for (int i = first; i < last; ++i) {
     auto r = level.work.template segment<B>(B * i);
@@ -654,7 +659,8 @@ void prolong_rows(Level<B>& level, const Level<kModes>& coarse, int first, int l
 
 // Gauss-Seidel on A x = 0 for each column of the modes, symmetric sweeps on the whole matrix
 // in one thread: PyAMG's improve_candidates, once at set-up.
-void relax_modes(const Level<3>& level, int sweeps, std::vector<Eigen::Matrix<double, 3, kModes>>& modes) {
+void relax_modes(const Level<3>& level, int sweeps,
+                 std::vector<Eigen::Matrix<double, 3, kModes>>& modes) {
   const auto& A = level.A;
   const int n = level.nodes();
   for (int s = 0; s < 2 * sweeps; ++s)
@@ -835,8 +841,9 @@ void Multigrid::prepare_own(Level<B>& level, std::size_t next, bool collective, 
   const bool new_prolongator =
       settings_.smooth_prolongator && (settings_.update_prolongator || !prolongators_ready_);
   on_one_thread(collective, [&] {
-    const bool weights = !gauss_seidel && (settings_.smoother == MultigridSettings::Smoother::Chebyshev ||
-                                           settings_.jacobi_weight <= 0.0);
+    const bool weights =
+        !gauss_seidel && (settings_.smoother == MultigridSettings::Smoother::Chebyshev ||
+                          settings_.jacobi_weight <= 0.0);
     if (new_prolongator || weights) {
       // Later estimates start from the last one's vector: a few iterations suffice.
       const int iterations = prolongators_ready_ ? std::min(3, settings_.power_iterations)
@@ -918,9 +925,11 @@ template <int B>
 void Multigrid::coarse_correction(Level<B>& level, std::size_t next, const Eigen::VectorXd& x,
                                   bool collective) {
   Level<kModes>& coarse = coarse_[next];
-  for_parts(coarse, collective, [&](int first, int last) { restrict_rows(level, coarse, first, last); });
+  for_parts(coarse, collective,
+            [&](int first, int last) { restrict_rows(level, coarse, first, last); });
   cycle(coarse, next + 1, coarse.b, coarse.x, collective);
-  for_parts(level, collective, [&](int first, int last) { prolong_rows(level, coarse, first, last, x); });
+  for_parts(level, collective,
+            [&](int first, int last) { prolong_rows(level, coarse, first, last, x); });
 }
 
 void Multigrid::count_cycle() {

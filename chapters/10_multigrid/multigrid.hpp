@@ -10,9 +10,9 @@
 // and apply(r, z) is one V-cycle. Neither allocates.
 //
 // Both run on every thread of the caller's OpenMP team: every loop is shared out like an
-// orphaned `omp for` (chapter 09's StaticShare) over the level's fixed row blocks, every sum runs in a fixed order, so the result is the
-// same to the last bit for any thread count. Called outside a parallel region, they run on
-// the calling thread alone.
+// orphaned `omp for` (chapter 09's StaticShare) over the level's fixed row blocks, every sum runs
+// in a fixed order, so the result is the same to the last bit for any thread count. Called outside
+// a parallel region, they run on the calling thread alone.
 //
 // The coarse matrices live across steps: prepare() recomputes them every k-th call, or
 // earlier when the V-cycles per solve grow (the refresh rule); the finest level always uses
@@ -51,8 +51,8 @@ struct MultigridSettings {
   // coarse blocks stay 6 x 6; unused modes become identity rows, as constrained dofs do.
   int modes = kModes;
   Smoother smoother = Smoother::Chebyshev;
-  int sweeps = 1;              // pre- and post-smoothing sweeps per level
-  bool l1 = true;              // Gauss-Seidel: the l1 term (false: plain hybrid Gauss-Seidel)
+  int sweeps = 1;  // pre- and post-smoothing sweeps per level
+  bool l1 = true;  // Gauss-Seidel: the l1 term (false: plain hybrid Gauss-Seidel)
   // The fixed row blocks of every level: at most max_blocks blocks of at least block_rows
   // rows of 3x3 blocks (a quarter as many rows of 6x6), equal in stored blocks. They are the
   // Gauss-Seidel smoother's blocks and the unit of work that threads share out; a function of
@@ -62,12 +62,12 @@ struct MultigridSettings {
   // A level with fewer rows than this runs (with all levels below it) on one thread: there a
   // barrier costs more than the work it shares out.
   int serial_rows = 0;
-  int chebyshev_degree = 3;        // Chebyshev: SpMVs per smoothing
-  double chebyshev_ratio = 30.0;   // smooths the eigenvalues in [lambda_max / ratio, lambda_max]
-  double jacobi_weight = 0.0;      // Jacobi smoother: 0 means 1 / rho(D^-1 A)
+  int chebyshev_degree = 3;         // Chebyshev: SpMVs per smoothing
+  double chebyshev_ratio = 30.0;    // smooths the eigenvalues in [lambda_max / ratio, lambda_max]
+  double jacobi_weight = 0.0;       // Jacobi smoother: 0 means 1 / rho(D^-1 A)
   bool smooth_prolongator = true;   // P = (I - w D^-1 A) T; false: P = T (plain aggregation)
   bool update_prolongator = false;  // smooth P at every refresh (default: on the first)
-  int power_iterations = 30;        // the first estimate of rho(D^-1 A) (see README: 10 was too few)
+  int power_iterations = 30;  // the first estimate of rho(D^-1 A) (see README: 10 was too few)
   // Sweeps of symmetric Gauss-Seidel on A B = 0 that improve the rigid-body modes B on the
   // first matrix before T is built (PyAMG's improve_candidates); 0: the modes as they are.
   int improve_candidates = 4;
@@ -92,7 +92,7 @@ struct Level {
   using Vector = Eigen::Matrix<double, B, 1>;
   using Transfer = Eigen::Matrix<double, B, kModes>;
 
-  BlockCsr<B, B> A;           // pattern; values in A.blocks except on the finest level
+  BlockCsr<B, B> A;  // pattern; values in A.blocks except on the finest level
   const Block* values = nullptr;
   std::vector<int> diagonal;   // per node: index of block (i, i)
   std::vector<int> transpose;  // per block (i, j): index of block (j, i) (coarse levels)
@@ -108,7 +108,7 @@ struct Level {
   // degenerate), where the Galerkin matrix is zero and gets the identity, as I - S does.
   std::vector<Eigen::Matrix<double, B, 1>> unused;
 
-  bool coarsest = true;  // no transfer below: solved by the dense Cholesky
+  bool coarsest = true;                 // no transfer below: solved by the dense Cholesky
   std::vector<std::vector<int>> graph;  // the neighbours that aggregation considers
   std::vector<int> aggregate;           // per node: its aggregate (coarse node)
   std::vector<Transfer> modes;          // per node: its near-null-space modes (before T)
@@ -132,9 +132,9 @@ struct Level {
   // per coarse row c, its targets start at galerkin_start[c], in loop order.
   std::vector<int> galerkin_first;
   std::vector<int> galerkin_target, galerkin_start;
-  double omega = 0.0;           // prolongator smoothing weight 4 / (3 rho)
-  double jacobi_weight = 0.0;   // smoother weight (Jacobi smoother)
-  double lambda_max = 0.0;      // rho(D^-1 A) (Chebyshev smoother)
+  double omega = 0.0;             // prolongator smoothing weight 4 / (3 rho)
+  double jacobi_weight = 0.0;     // smoother weight (Jacobi smoother)
+  double lambda_max = 0.0;        // rho(D^-1 A) (Chebyshev smoother)
   std::vector<double> chebyshev;  // per Chebyshev step: the weights of d and of D^-1 r
 
   // Right-hand side, solution, the ping-pong partner of x, residual, Chebyshev direction,

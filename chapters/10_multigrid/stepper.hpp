@@ -29,9 +29,9 @@ class VCyclePreconditioner final : public ch09::Preconditioner {
 // Not final: chapter 11 runs this step on a renumbered mesh.
 class MultigridStepper : public ch09::ThreadsStepper {
  public:
-  MultigridStepper(const Scene& scene, const SolverSettings& settings,
-                   const MultigridSettings& multigrid = {},
-                   ch09::ElementParallelism element_parallelism = ch09::ElementParallelism::colouring);
+  MultigridStepper(
+      const Scene& scene, const SolverSettings& settings, const MultigridSettings& multigrid = {},
+      ch09::ElementParallelism element_parallelism = ch09::ElementParallelism::colouring);
 
   const Multigrid& multigrid() const { return multigrid_; }
   Multigrid& multigrid() { return multigrid_; }
@@ -42,7 +42,7 @@ class MultigridStepper : public ch09::ThreadsStepper {
 
   Multigrid multigrid_;  // set up from the pattern of the system matrix
   VCyclePreconditioner v_cycle_{multigrid_};
-  int extrapolation_;            // the guess's order: 0, 1 or 2
+  int extrapolation_;           // the guess's order: 0, 1 or 2
   Eigen::VectorXd history_[2];  // the solutions of the two steps before the last
   int solves_ = 0;
 };

@@ -41,7 +41,8 @@ std::vector<Run> runs_for(const LessonRun& run) {
       Scene scene = make_scene(run.scene.name, load_mesh(path.string()), run.scene.material);
       scene.dt = run.scene.dt;
       scene.damping = run.scene.damping;
-      runs.push_back({std::string("gmsh ") + method, std::move(scene), Ordering::file, nullptr, {}, {}, {}});
+      runs.push_back(
+          {std::string("gmsh ") + method, std::move(scene), Ordering::file, nullptr, {}, {}, {}});
       break;
     }
   }
@@ -59,10 +60,12 @@ std::string row(Run& r) {
   const OrderQuality q = order_quality(renumbered(r.scene, r.stepper->order(), false).mesh);
   const auto& A = r.stepper->system_matrix();
   Eigen::VectorXd x = Eigen::VectorXd::Ones(3 * A.block_rows()), y(x.size());
-  const double spmv = time_ms(50, [&] { A.multiply(x, y); }, 2.0);
+  const double spmv = time_ms(
+      50, [&] { A.multiply(x, y); }, 2.0);
   const Eigen::VectorXd rhs = r.stepper->system_rhs();
   Eigen::VectorXd s(rhs.size());
-  const double v_cycle = time_ms(20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
+  const double v_cycle = time_ms(
+      20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
   const int n = r.scene.mesh.num_nodes();
   std::ostringstream out;
   out << "| " << r.name << " | " << q.bandwidth << " | " << fixed(q.profile / n, 0) << " | "
@@ -81,7 +84,9 @@ std::string one_mesh_table(const LessonRun& run) {
   // Interleaved, one step of each order in turn, as fem_bench runs chapters: a drift of the
   // machine's speed hits every order alike. The first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
-    if (k % 5 == 0) progress("node-order: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+    if (k % 5 == 0)
+      progress("node-order: step " + std::to_string(k + 1) + " of " +
+               std::to_string(run.steps + 2));
     for (Run& r : runs) {
       r.stepper->step(r.state);
       if (k < 2) continue;
@@ -116,7 +121,8 @@ std::string node_order_table(const LessonRun& run) {
     scenes.back().damping = run.scene.damping;
   }
   std::string tables = one_mesh_table(run);
-  for (const Scene& scene : scenes) tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});
+  for (const Scene& scene : scenes)
+    tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});
   return tables;
 }
 
@@ -127,10 +133,11 @@ void add_node_order_options(ArgParser& args) {
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {{"node-order",
-           "the same scene in each node order: bandwidth, element spread, element pass, SpMV, V-cycle",
-           "meshes/plate_poster.msh", add_node_order_options,
-           [](const LessonRun& run) { return node_order_table(run); }, false}};
+  return {
+      {"node-order",
+       "the same scene in each node order: bandwidth, element spread, element pass, SpMV, V-cycle",
+       "meshes/plate_poster.msh", add_node_order_options,
+       [](const LessonRun& run) { return node_order_table(run); }, false}};
 }
 
 }  // namespace fem::ch11

@@ -18,10 +18,14 @@ Ordering ordering_from_name(const std::string& name) {
 
 std::string ordering_name(Ordering ordering) {
   switch (ordering) {
-    case Ordering::original: return "original";
-    case Ordering::file: return "file";
-    case Ordering::rcm: return "rcm";
-    case Ordering::morton: return "morton";
+    case Ordering::original:
+      return "original";
+    case Ordering::file:
+      return "file";
+    case Ordering::rcm:
+      return "rcm";
+    case Ordering::morton:
+      return "morton";
   }
   return "?";
 }
@@ -96,11 +100,10 @@ int pseudo_peripheral(const std::vector<std::vector<int>>& adjacency, int start,
     const Search search = breadth_first(adjacency, start, seen, order);
     if (search.levels <= levels) break;
     levels = search.levels;
-    start = *std::min_element(order.begin() + static_cast<long>(search.last_level), order.end(),
-                              [&](int a, int b) {
-                                return std::make_pair(degree(adjacency, a), a) <
-                                       std::make_pair(degree(adjacency, b), b);
-                              });
+    start = *std::min_element(
+        order.begin() + static_cast<long>(search.last_level), order.end(), [&](int a, int b) {
+          return std::make_pair(degree(adjacency, a), a) < std::make_pair(degree(adjacency, b), b);
+        });
   }
   return start;
 }
@@ -173,12 +176,13 @@ TetMesh renumbered_mesh(const TetMesh& mesh, const NodeOrder& order, bool sort_e
     for (int a = 0; a < 3; ++a) f[a] = order.new_of_old[f[a]];
   if (!sort_elements) return out;
   // Elements by their smallest node, then the next: the pass walks the nodes forwards.
-  std::stable_sort(out.tets.begin(), out.tets.end(), [](const Eigen::Vector4i& a, const Eigen::Vector4i& b) {
-    std::array<int, 4> ka = {a[0], a[1], a[2], a[3]}, kb = {b[0], b[1], b[2], b[3]};
-    std::sort(ka.begin(), ka.end());
-    std::sort(kb.begin(), kb.end());
-    return ka < kb;
-  });
+  std::stable_sort(
+      out.tets.begin(), out.tets.end(), [](const Eigen::Vector4i& a, const Eigen::Vector4i& b) {
+        std::array<int, 4> ka = {a[0], a[1], a[2], a[3]}, kb = {b[0], b[1], b[2], b[3]};
+        std::sort(ka.begin(), ka.end());
+        std::sort(kb.begin(), kb.end());
+        return ka < kb;
+      });
   return out;
 }
 
@@ -191,8 +195,9 @@ Scene renumbered(const Scene& scene, const NodeOrder& order, bool sort_elements)
   Scene out = scene;
   out.mesh = renumbered_mesh(scene.mesh, order, sort_elements);
   for (auto& c : out.constraints) c.node = order.new_of_old[c.node];
-  std::stable_sort(out.constraints.begin(), out.constraints.end(),
-                   [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+  std::stable_sort(
+      out.constraints.begin(), out.constraints.end(),
+      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
   for (auto& f : out.external_forces) f.node = order.new_of_old[f.node];
   return out;
 }
@@ -202,8 +207,8 @@ OrderQuality order_quality(const TetMesh& mesh) {
   const auto adjacency = node_adjacency(mesh);
   for (std::size_t i = 0; i < adjacency.size(); ++i) {
     const int low = adjacency[i].front(), high = adjacency[i].back();  // sorted rows
-    q.bandwidth = std::max<long long>(q.bandwidth, std::max(static_cast<int>(i) - low,
-                                                            high - static_cast<int>(i)));
+    q.bandwidth = std::max<long long>(
+        q.bandwidth, std::max(static_cast<int>(i) - low, high - static_cast<int>(i)));
     q.profile += static_cast<double>(static_cast<int>(i) - low);
   }
   for (const auto& t : mesh.tets) q.element_spread += t.maxCoeff() - t.minCoeff();

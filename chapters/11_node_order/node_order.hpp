@@ -60,9 +60,9 @@ Scene renumbered(const Scene& scene, const NodeOrder& order, bool sort_elements 
 
 // How far apart the numbers of coupled nodes are: the measures the order is meant to shrink.
 struct OrderQuality {
-  long long bandwidth = 0;       // max |i - j| over coupled nodes i, j
-  double profile = 0.0;          // sum over rows of (i - min j): the envelope, in nodes
-  double element_spread = 0.0;   // mean over elements of (max - min) of its node numbers
+  long long bandwidth = 0;      // max |i - j| over coupled nodes i, j
+  double profile = 0.0;         // sum over rows of (i - min j): the envelope, in nodes
+  double element_spread = 0.0;  // mean over elements of (max - min) of its node numbers
 };
 OrderQuality order_quality(const TetMesh& mesh);
 

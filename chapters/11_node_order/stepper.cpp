@@ -14,7 +14,8 @@ NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& set
 NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
                                    Ordering ordering, NodeOrder order,
                                    const ch10::MultigridSettings& multigrid)
-    : MultigridStepper(renumbered(scene, order, ordering != Ordering::original), settings, multigrid),
+    : MultigridStepper(renumbered(scene, order, ordering != Ordering::original), settings,
+                       multigrid),
       ordering_(ordering),
       order_(std::move(order)),
       inner_(rest_state(scene_)),
@@ -26,7 +27,8 @@ NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& set
   // consecutive elements form a slab: 64 slabs need a handful of colours (the plate: 5), and
   // the pass walks A about once. (The slabs depend on the mesh only, so the state stays the
   // same for any thread count; the test ch11_node_order.cpp counts the colours.)
-  if (ordering_ != Ordering::original) colour_element_groups(std::max(16, scene_.mesh.num_tets() / kSlabs));
+  if (ordering_ != Ordering::original)
+    colour_element_groups(std::max(16, scene_.mesh.num_tets() / kSlabs));
 }
 
 void NodeOrderStepper::step(State& state) {

@@ -14,7 +14,8 @@ namespace fem::ch11 {
 class NodeOrderStepper : public ch10::MultigridStepper {
  public:
   NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
-                   Ordering ordering = Ordering::rcm, const ch10::MultigridSettings& multigrid = {});
+                   Ordering ordering = Ordering::rcm,
+                   const ch10::MultigridSettings& multigrid = {});
 
   // The caller's state in the mesh's numbering, in and out; chapter 10's step in between.
   void step(State& state) override;

@@ -80,16 +80,18 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
 #pragma omp simd
       for (int l = 0; l < kLanes; ++l)
         n.F[3 * i + j].v[l] = ds[3 * i + 0].v[l] * dm[0 + j].v[l] +
-                              ds[3 * i + 1].v[l] * dm[3 + j].v[l] + ds[3 * i + 2].v[l] * dm[6 + j].v[l];
+                              ds[3 * i + 1].v[l] * dm[3 + j].v[l] +
+                              ds[3 * i + 2].v[l] * dm[6 + j].v[l];
     }
 #pragma omp simd
   for (int l = 0; l < kLanes; ++l) {
     const double f0 = n.F[0].v[l], f1 = n.F[1].v[l], f2 = n.F[2].v[l], f3 = n.F[3].v[l],
                  f4 = n.F[4].v[l], f5 = n.F[5].v[l], f6 = n.F[6].v[l], f7 = n.F[7].v[l],
                  f8 = n.F[8].v[l];
-    const double norm2 = f0 * f0 + f1 * f1 + f2 * f2 + f3 * f3 + f4 * f4 + f5 * f5 + f6 * f6 +
-                         f7 * f7 + f8 * f8;
-    const double det = f0 * (f4 * f8 - f5 * f7) - f1 * (f3 * f8 - f5 * f6) + f2 * (f3 * f7 - f4 * f6);
+    const double norm2 =
+        f0 * f0 + f1 * f1 + f2 * f2 + f3 * f3 + f4 * f4 + f5 * f5 + f6 * f6 + f7 * f7 + f8 * f8;
+    const double det =
+        f0 * (f4 * f8 - f5 * f7) - f1 * (f3 * f8 - f5 * f6) + f2 * (f3 * f7 - f4 * f6);
     const double scale2 = norm2 / 3.0;
     n.scale2.v[l] = scale2;
     // det > k s^(3/2), squared: chapter 08's test (and false for NaN, as there).
@@ -100,11 +102,16 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
     n.status[l] = decides ? kIterating : kFailed;
     // Newton's start, last * conj(before) * last: quaternion products written out (w, x, y, z).
     const double aw = last[0].v[l], ax = last[1].v[l], ay = last[2].v[l], az = last[3].v[l];
-    const double bw = before[0].v[l], bx = -before[1].v[l], by = -before[2].v[l], bz = -before[3].v[l];
-    const double cw = aw * bw - ax * bx - ay * by - az * bz, cx = aw * bx + ax * bw + ay * bz - az * by,
-                 cy = aw * by - ax * bz + ay * bw + az * bx, cz = aw * bz + ax * by - ay * bx + az * bw;
-    const double qw = cw * aw - cx * ax - cy * ay - cz * az, qx = cw * ax + cx * aw + cy * az - cz * ay,
-                 qy = cw * ay - cx * az + cy * aw + cz * ax, qz = cw * az + cx * ay - cy * ax + cz * aw;
+    const double bw = before[0].v[l], bx = -before[1].v[l], by = -before[2].v[l],
+                 bz = -before[3].v[l];
+    const double cw = aw * bw - ax * bx - ay * by - az * bz,
+                 cx = aw * bx + ax * bw + ay * bz - az * by,
+                 cy = aw * by - ax * bz + ay * bw + az * bx,
+                 cz = aw * bz + ax * by - ay * bx + az * bw;
+    const double qw = cw * aw - cx * ax - cy * ay - cz * az,
+                 qx = cw * ax + cx * aw + cy * az - cz * ay,
+                 qy = cw * ay - cx * az + cy * aw + cz * ax,
+                 qz = cw * az + cx * ay - cy * ax + cz * aw;
     n.q[0].v[l] = n.start[0].v[l] = qw;
     n.q[1].v[l] = n.start[1].v[l] = qx;
     n.q[2].v[l] = n.start[2].v[l] = qy;
@@ -122,9 +129,12 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
     for (int l = 0; l < kLanes; ++l) {
       const double w = n.q[0].v[l], x = n.q[1].v[l], y = n.q[2].v[l], z = n.q[3].v[l];
       // |q|^2 R(q / |q|), chapter 08's scaled_rotation.
-      const double r0 = w * w + x * x - y * y - z * z, r1 = 2.0 * (x * y - w * z), r2 = 2.0 * (x * z + w * y);
-      const double r3 = 2.0 * (x * y + w * z), r4 = w * w - x * x + y * y - z * z, r5 = 2.0 * (y * z - w * x);
-      const double r6 = 2.0 * (x * z - w * y), r7 = 2.0 * (y * z + w * x), r8 = w * w - x * x - y * y + z * z;
+      const double r0 = w * w + x * x - y * y - z * z, r1 = 2.0 * (x * y - w * z),
+                   r2 = 2.0 * (x * z + w * y);
+      const double r3 = 2.0 * (x * y + w * z), r4 = w * w - x * x + y * y - z * z,
+                   r5 = 2.0 * (y * z - w * x);
+      const double r6 = 2.0 * (x * z - w * y), r7 = 2.0 * (y * z + w * x),
+                   r8 = w * w - x * x - y * y + z * z;
       const double f0 = n.F[0].v[l], f1 = n.F[1].v[l], f2 = n.F[2].v[l], f3 = n.F[3].v[l],
                    f4 = n.F[4].v[l], f5 = n.F[5].v[l], f6 = n.F[6].v[l], f7 = n.F[7].v[l],
                    f8 = n.F[8].v[l];
@@ -145,14 +155,15 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
       // det H > 1e-12 q2^3 s2^(3/2), squared (chapter 08's solve_positive_definite).
       const double q6 = q2 * q2 * q2;
       // w = H^-1 axial by the adjugate: its numerators here, the division in a loop of its own.
-      const double a0 = H11 * H22 - H12 * H12, a1 = H02 * H12 - H01 * H22, a2 = H01 * H12 - H02 * H11;
+      const double a0 = H11 * H22 - H12 * H12, a1 = H02 * H12 - H01 * H22,
+                   a2 = H01 * H12 - H02 * H11;
       const double a4 = H00 * H22 - H02 * H02, a5 = H01 * H02 - H00 * H12;
       step[0].v[l] = a0 * b0 + a1 * b1 + a2 * b2;
       step[1].v[l] = a1 * b0 + a4 * b1 + a5 * b2;
       step[2].v[l] = a2 * b0 + a5 * b1 + minor2 * b2;
       determinant.v[l] = det;
-      definite[l] = (H00 > 0.0) & (minor2 > 0.0) & (det > 0.0) &
-                    (det * det > 1e-24 * q6 * q6 * s2 * s2 * s2);
+      definite[l] =
+          (H00 > 0.0) & (minor2 > 0.0) & (det > 0.0) & (det * det > 1e-24 * q6 * q6 * s2 * s2 * s2);
     }
     // Kept apart: with -ftrapping-math (GCC's default) a division that only some lanes use is
     // not executed for all of them, and the loop would stay scalar.
@@ -234,7 +245,8 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
     for (int j = 0; j < 3; ++j) {
 #pragma omp simd
       for (int l = 0; l < kLanes; ++l)
-        r[i][j + 1].v[l] = R[3 * i + 0].v[l] * dm[3 * j + 0].v[l] + R[3 * i + 1].v[l] * dm[3 * j + 1].v[l] +
+        r[i][j + 1].v[l] = R[3 * i + 0].v[l] * dm[3 * j + 0].v[l] +
+                           R[3 * i + 1].v[l] * dm[3 * j + 1].v[l] +
                            R[3 * i + 2].v[l] * dm[3 * j + 2].v[l];
     }
 #pragma omp simd
@@ -265,15 +277,16 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
     for (int a = 0; a < 4; ++a) {
 #pragma omp simd
       for (int l = 0; l < kLanes; ++l)
-        out.rhs[i][a].v[l] = P[i][0].v[l] * r[0][a].v[l] + P[i][1].v[l] * r[1][a].v[l] +
-                             P[i][2].v[l] * r[2][a].v[l];
+        out.rhs[i][a].v[l] =
+            P[i][0].v[l] * r[0][a].v[l] + P[i][1].v[l] * r[1][a].v[l] + P[i][2].v[l] * r[2][a].v[l];
     }
   for (int p = 0; p < 10; ++p) {
     const int a = ch08::kUpperPairs[p][0], b = ch08::kUpperPairs[p][1];
     Lanes dot;
 #pragma omp simd
     for (int l = 0; l < kLanes; ++l)
-      dot.v[l] = r[0][a].v[l] * r[0][b].v[l] + r[1][a].v[l] * r[1][b].v[l] + r[2][a].v[l] * r[2][b].v[l];
+      dot.v[l] =
+          r[0][a].v[l] * r[0][b].v[l] + r[1][a].v[l] * r[1][b].v[l] + r[2][a].v[l] * r[2][b].v[l];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
 #pragma omp simd

@@ -3,9 +3,9 @@
 
 #include <algorithm>
 #include <iomanip>
-#include <stdexcept>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "chapters/08_element_kernels/element_kernels.hpp"
@@ -61,9 +61,12 @@ std::unique_ptr<ch11::NodeOrderStepper> make(const Scene& scene, int variant, do
 double v_cycle_ms(Run& r, int variant) {
   const Eigen::VectorXd rhs = r.stepper->system_rhs();
   Eigen::VectorXd s(rhs.size());
-  if (variant == 0) return time_ms(20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
+  if (variant == 0)
+    return time_ms(
+        20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
   auto& v_cycle = static_cast<HalfBytesStepper&>(*r.stepper).v_cycle();
-  return time_ms(20, [&] { v_cycle.apply(ch09::RowChunks{}, rhs, s); }, 2.0);
+  return time_ms(
+      20, [&] { v_cycle.apply(ch09::RowChunks{}, rhs, s); }, 2.0);
 }
 
 std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tight) {
@@ -82,7 +85,8 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
   // Interleaved, one step of each in turn; the first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
     if (k % 5 == 0)
-      progress("half-the-bytes: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+      progress("half-the-bytes: step " + std::to_string(k + 1) + " of " +
+               std::to_string(run.steps + 2));
     for (Run& r : runs) {
       r.stepper->step(r.state);
       r.converged = r.converged && r.stepper->profile().converged;
@@ -131,7 +135,8 @@ std::string half_the_bytes_table(const LessonRun& run) {
       used = 0;
     }
     if (used != t.size() || !(value > 0.0 && value < 1.0))
-      throw std::invalid_argument("--tight: tolerances in (0, 1), comma-separated, not '" + t + "'");
+      throw std::invalid_argument("--tight: tolerances in (0, 1), comma-separated, not '" + t +
+                                  "'");
     tight.push_back(value);
   }
   std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
@@ -164,7 +169,8 @@ std::string one_mesh_elements(const LessonRun& run) {
   BatchTerms batch;
   for (int k = 0; k < run.steps + 2; ++k) {
     if (k % 10 == 0)
-      progress("batched-elements: step " + std::to_string(k + 1) + " of " + std::to_string(run.steps + 2));
+      progress("batched-elements: step " + std::to_string(k + 1) + " of " +
+               std::to_string(run.steps + 2));
     stepper.step(state);
     long long f1 = 0, f2 = 0;
     const double t1 = time_ms(1, [&] {
@@ -203,9 +209,11 @@ std::string batched_elements_table(const LessonRun& run) {
       "| mesh | elements | one at a time (chapter 08), ns per element | " + std::to_string(kLanes) +
       " at a time (chapter 12), ns per element | speedup |\n| --- | ---: | ---: | ---: | ---: |\n";
   table += one_mesh_elements(run);
-  for (const Scene& scene : scenes) table += one_mesh_elements({run.args, scene, run.steps, run.chapter});
-  return table + "\nOne thread; the terms of every element (rotation, forces, the ten blocks), "
-                 "without the scatter into A and b; medians over " +
+  for (const Scene& scene : scenes)
+    table += one_mesh_elements({run.args, scene, run.steps, run.chapter});
+  return table +
+         "\nOne thread; the terms of every element (rotation, forces, the ten blocks), "
+         "without the scatter into A and b; medians over " +
          std::to_string(run.steps) + " passes on the states of a run of chapter 12. " +
          measured_on() + ".\n";
 }
@@ -216,20 +224,23 @@ void add_element_options(ArgParser& args) {
 
 void add_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
-  args.option("tight", "LIST", "the tight tolerances of the last columns, comma-separated", "1e-8,1e-12");
+  args.option("tight", "LIST", "the tight tolerances of the last columns, comma-separated",
+              "1e-8,1e-12");
 }
 
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {{"half-the-bytes",
-           "the V-cycle in double, in float, and float numbers in double arithmetic: bytes, time, iterations",
-           "meshes/plate_poster.msh", add_options,
-           [](const LessonRun& run) { return half_the_bytes_table(run); }, false},
-          {"batched-elements",
-           "the element terms one at a time (chapter 08) and a batch per vector register (chapter 12)",
-           "meshes/plate_poster.msh", add_element_options,
-           [](const LessonRun& run) { return batched_elements_table(run); }, false}};
+  return {
+      {"half-the-bytes",
+       "the V-cycle in double, in float, and float numbers in double arithmetic: bytes, time, "
+       "iterations",
+       "meshes/plate_poster.msh", add_options,
+       [](const LessonRun& run) { return half_the_bytes_table(run); }, false},
+      {"batched-elements",
+       "the element terms one at a time (chapter 08) and a batch per vector register (chapter 12)",
+       "meshes/plate_poster.msh", add_element_options,
+       [](const LessonRun& run) { return batched_elements_table(run); }, false}};
 }
 
 }  // namespace fem::ch12

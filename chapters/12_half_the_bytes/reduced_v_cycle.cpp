@@ -134,8 +134,8 @@ void restrict_rows(const ReducedLevel<Real, B>& level, ReducedLevel<Real, kModes
 
 // y = x + P x_c on rows [first, last).
 template <class Real, int B>
-void prolong_rows(ReducedLevel<Real, B>& level, const ReducedLevel<Real, kModes>& coarse,
-                  int first, int last, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
+void prolong_rows(ReducedLevel<Real, B>& level, const ReducedLevel<Real, kModes>& coarse, int first,
+                  int last, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
   const auto& P = level.source->P;
   for (int i = first; i < last; ++i) {
     Wide<Real, B> sum = Wide<Real, B>::Zero();
@@ -171,7 +171,8 @@ ReducedVCycle<Real>::ReducedVCycle(ch10::Multigrid& multigrid) : multigrid_(mult
         "float V-cycle: the polynomial smoothers only (Chebyshev, Jacobi), not Gauss-Seidel");
   size_level(fine_, multigrid.fine_level());
   coarse_.resize(multigrid.levels() - 1);
-  for (int l = 1; l < multigrid.levels(); ++l) size_level(coarse_[l - 1], multigrid.coarse_level(l));
+  for (int l = 1; l < multigrid.levels(); ++l)
+    size_level(coarse_[l - 1], multigrid.coarse_level(l));
   r_.setZero(fine_.source->dofs());
   s_.setZero(fine_.source->dofs());
 }
@@ -227,11 +228,13 @@ void ReducedVCycle<Real>::apply(const ch09::RowChunks&, const Eigen::VectorXd& r
     cycle(fine_, 0, r, s, true);
   } else {
     for_parts(fine_, true, [&](int first, int last) {
-      r_.segment(3 * first, 3 * (last - first)) = r.segment(3 * first, 3 * (last - first)).template cast<float>();
+      r_.segment(3 * first, 3 * (last - first)) =
+          r.segment(3 * first, 3 * (last - first)).template cast<float>();
     });
     cycle(fine_, 0, r_, s_, true);
     for_parts(fine_, true, [&](int first, int last) {
-      s.segment(3 * first, 3 * (last - first)) = s_.segment(3 * first, 3 * (last - first)).template cast<double>();
+      s.segment(3 * first, 3 * (last - first)) =
+          s_.segment(3 * first, 3 * (last - first)).template cast<double>();
     });
   }
 }
@@ -268,11 +271,14 @@ void ReducedVCycle<Real>::cycle(ReducedLevel<Real, B>& level, std::size_t next, 
     });
     current = &target;
   }
-  for_parts(level, collective, [&](int first, int last) { residual(level, first, last, b, *current); });
+  for_parts(level, collective,
+            [&](int first, int last) { residual(level, first, last, b, *current); });
   ReducedLevel<Real, kModes>& coarse = coarse_[next];
-  for_parts(coarse, collective, [&](int first, int last) { restrict_rows(level, coarse, first, last); });
+  for_parts(coarse, collective,
+            [&](int first, int last) { restrict_rows(level, coarse, first, last); });
   cycle(coarse, next + 1, coarse.b, coarse.x, collective);
-  for_parts(level, collective, [&](int first, int last) { prolong_rows(level, coarse, first, last, *current); });
+  for_parts(level, collective,
+            [&](int first, int last) { prolong_rows(level, coarse, first, last, *current); });
   current = &level.y;
   for (int k = 0; k < steps; ++k) {
     Vector& target = (steps - k) % 2 == 1 ? out : level.work;

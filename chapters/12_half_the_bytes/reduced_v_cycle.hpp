@@ -74,7 +74,7 @@ class ReducedVCycle final : public ch09::Preconditioner {
   ch10::Multigrid& multigrid_;
   ReducedLevel<Real, 3> fine_;
   std::vector<ReducedLevel<Real, kModes>> coarse_;
-  Vector r_, s_;  // the PCG's residual and its preconditioned residual in Real
+  Vector r_, s_;            // the PCG's residual and its preconditioned residual in Real
   bool converted_ = false;  // the coarse levels, prolongators and weights read once
 };
 

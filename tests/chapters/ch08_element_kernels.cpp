@@ -61,9 +61,10 @@ TEST_CASE("ch08: warm-started Newton gives the SVD rotation on large rotations a
   }
 }
 
-TEST_CASE("ch08: the fast rotation equals the SVD path with the fallback where Newton cannot "
-          "decide",
-          "[ch08]") {
+TEST_CASE(
+    "ch08: the fast rotation equals the SVD path with the fallback where Newton cannot "
+    "decide",
+    "[ch08]") {
   std::mt19937 rng(80);
   struct Case {
     const char* name;
@@ -126,8 +127,7 @@ TEST_CASE("ch08: the closed-form blocks equal common's dfdx_block for every elem
       closed_form.block<3, 3>(3 * b, 3 * a) = K[p].transpose();
     }
     INFO("element " << e);
-    CHECK((closed_form - expected).cwiseAbs().maxCoeff() <=
-          1e-13 * expected.cwiseAbs().maxCoeff());
+    CHECK((closed_form - expected).cwiseAbs().maxCoeff() <= 1e-13 * expected.cwiseAbs().maxCoeff());
     largest = std::max(largest, (R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
   }
   CHECK(largest > 1e-3);  // the rotations are not all the identity
@@ -194,7 +194,9 @@ TEST_CASE("ch08: a stepper created on a turned body starts cold and then warm", 
     separate.step(a);
     fused.step(b);
     INFO("step " << k);
-    if (k == 0) CHECK(fused.elements().last_step_fallbacks() == static_cast<long long>(scene.mesh.num_tets()));
+    if (k == 0)
+      CHECK(fused.elements().last_step_fallbacks() ==
+            static_cast<long long>(scene.mesh.num_tets()));
     if (k > 0) CHECK(fused.elements().last_step_fallbacks() == 0);  // warm from the SVD's rotations
     const Eigen::SparseMatrix<double> A07 = separate.system_matrix().to_sparse();
     CHECK((A07 - fused.system_matrix().to_sparse()).norm() <= 1e-13 * A07.norm());

@@ -100,8 +100,7 @@ TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thr
   }
 }
 
-TEST_CASE("ch09: zero heap allocations per step after the first, with 2 threads",
-          "[ch09][alloc]") {
+TEST_CASE("ch09: zero heap allocations per step after the first, with 2 threads", "[ch09][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();
   // The counter sees every thread's allocations. OpenMP's set-up, the first time a region
   // has a team of a new size (libgomp's threads and its team structure), falls in the first

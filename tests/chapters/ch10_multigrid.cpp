@@ -7,7 +7,6 @@
 #include <random>
 
 #include "catch2_compat.hpp"
-
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/threads.hpp"
@@ -21,7 +20,8 @@ std::vector<Scene> all_scenes() { return test::equivalence_scenes(); }
 
 Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
   Eigen::VectorXd v = Eigen::VectorXd::Random(size);
-  for (const auto& c : scene.constraints) v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
+  for (const auto& c : scene.constraints)
+    v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
   return v;
 }
 
@@ -106,8 +106,7 @@ TEST_CASE("ch10: the V-cycle is symmetric positive definite on the filtered spac
   }
 }
 
-TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a refresh",
-          "[ch10]") {
+TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a refresh", "[ch10]") {
   // The default refresh rule keeps the coarse matrices for several steps: step until a refresh
   // past the first one (the prolongator is smoothed on the first), then compare.
   for (const Scene& scene : all_scenes()) {
@@ -188,8 +187,7 @@ TEST_CASE("ch10: iterations on the test mesh at most 8, a sixth of the block-Jac
   }
 }
 
-TEST_CASE("ch10: zero heap allocations per step after the first, with 2 threads",
-          "[ch10][alloc]") {
+TEST_CASE("ch10: zero heap allocations per step after the first, with 2 threads", "[ch10][alloc]") {
   FEM_REQUIRE_ALLOCATION_COUNTER();
   // OpenMP's team is set up in the first step (as in the threaded chapter before).
   const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
@@ -218,8 +216,7 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
 }
 
-TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle",
-          "[ch10]") {
+TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle", "[ch10]") {
   // A lagged V-cycle is still SPD, so PCG reaches the same tolerance: only iterations change.
   const Scene scene = test::driven_scene();
   ch10::MultigridSettings every_step = three_levels(), lagged = three_levels();

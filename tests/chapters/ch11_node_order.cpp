@@ -41,12 +41,12 @@ State moved_state(const Scene& scene) {
 
 }  // namespace
 
-TEST_CASE("ch11: every order is a permutation, and RCM and Morton shrink the bandwidth",
-          "[ch11]") {
+TEST_CASE("ch11: every order is a permutation, and RCM and Morton shrink the bandwidth", "[ch11]") {
   for (const std::string file : {"test_beam.msh", "plate_poster.msh"}) {
     const TetMesh mesh = load_mesh(test::mesh_path(file));
     const ch11::OrderQuality original = ch11::order_quality(mesh);
-    for (const auto ordering : {ch11::Ordering::original, ch11::Ordering::rcm, ch11::Ordering::morton}) {
+    for (const auto ordering :
+         {ch11::Ordering::original, ch11::Ordering::rcm, ch11::Ordering::morton}) {
       const ch11::NodeOrder order = ch11::node_order(mesh, ordering);
       INFO(file << ", " << ch11::ordering_name(ordering));
       CHECK(is_permutation(order, mesh.num_nodes()));
@@ -86,8 +86,9 @@ TEST_CASE("ch11: the renumbered scene is the same scene under another naming", "
   CHECK(a == b);
   REQUIRE(r.constraints.size() == scene.constraints.size());
   for (const NodeConstraint& c : scene.constraints) {
-    const auto it = std::find_if(r.constraints.begin(), r.constraints.end(),
-                                 [&](const NodeConstraint& d) { return d.node == order.new_of_old[c.node]; });
+    const auto it =
+        std::find_if(r.constraints.begin(), r.constraints.end(),
+                     [&](const NodeConstraint& d) { return d.node == order.new_of_old[c.node]; });
     REQUIRE(it != r.constraints.end());
     CHECK(it->filter == c.filter);
     CHECK(it->target_velocity == c.target_velocity);
@@ -135,9 +136,10 @@ TEST_CASE("ch11: the state maps in and out exactly, and forces keep the caller's
   ten.step(theirs);
   double worst = 0.0;
   for (int i = 0; i < scene.mesh.num_nodes(); ++i)
-    worst = std::max(worst, (mine.v.segment<3>(3 * i) - theirs.v.segment<3>(3 * order.new_of_old[i]))
-                                .cwiseAbs()
-                                .maxCoeff());
+    worst =
+        std::max(worst, (mine.v.segment<3>(3 * i) - theirs.v.segment<3>(3 * order.new_of_old[i]))
+                            .cwiseAbs()
+                            .maxCoeff());
   INFO("largest velocity difference " << worst << " of speed " << mine.v.cwiseAbs().maxCoeff());
   CHECK(worst <= 1e-12 * mine.v.cwiseAbs().maxCoeff());
   CHECK_THROWS_AS(eleven.set_external_forces({{scene.mesh.num_nodes(), Eigen::Vector3d::Ones()}}),

@@ -8,9 +8,9 @@
 #include <random>
 
 #include "catch2_compat.hpp"
+#include "chapters/08_element_kernels/element_kernels.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/stepper.hpp"
-#include "chapters/08_element_kernels/element_kernels.hpp"
 #include "chapters/12_half_the_bytes/element_batch.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "common/model.hpp"
@@ -25,7 +25,8 @@ namespace {
 
 Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
   Eigen::VectorXd v = Eigen::VectorXd::Random(size);
-  for (const auto& c : scene.constraints) v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
+  for (const auto& c : scene.constraints)
+    v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
   return v;
 }
 
@@ -55,7 +56,8 @@ std::pair<double, double> asymmetry_and_positivity(const Scene& scene) {
     const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
     v_cycle.apply(ch09::RowChunks{}, x, Mx);
     v_cycle.apply(ch09::RowChunks{}, y, My);
-    asymmetry = std::max(asymmetry, std::abs(x.dot(My) - y.dot(Mx)) / std::sqrt(x.dot(Mx) * y.dot(My)));
+    asymmetry =
+        std::max(asymmetry, std::abs(x.dot(My) - y.dot(Mx)) / std::sqrt(x.dot(Mx) * y.dot(My)));
     positivity = std::min({positivity, x.dot(Mx) / x.squaredNorm(), y.dot(My) / y.squaredNorm()});
   }
   return {asymmetry, positivity};
@@ -63,8 +65,7 @@ std::pair<double, double> asymmetry_and_positivity(const Scene& scene) {
 
 }  // namespace
 
-TEST_CASE("ch12: the float V-cycle is symmetric to its rounding and positive definite",
-          "[ch12]") {
+TEST_CASE("ch12: the float V-cycle is symmetric to its rounding and positive definite", "[ch12]") {
   // In float arithmetic the two sides of x^T M y = y^T M x round differently: symmetric to
   // float's 6e-8 times the cycle's few hundred operations. Widened to double, the float
   // numbers form an exactly symmetric operator (P^T is P transposed entry by entry, the
@@ -133,9 +134,9 @@ TEST_CASE("ch12: at most one iteration more than chapter 11 at 1e-4, and 1e-10 s
 TEST_CASE("ch12: refuses chapter 10's Gauss-Seidel smoother", "[ch12]") {
   ch10::MultigridSettings s;
   s.smoother = ch10::MultigridSettings::Smoother::GaussSeidel;
-  CHECK_THROWS_AS(ch12::HalfBytesStepper(test::test_scene("cantilever"), {},
-                                         ch12::Arithmetic::single, s),
-                  std::invalid_argument);
+  CHECK_THROWS_AS(
+      ch12::HalfBytesStepper(test::test_scene("cantilever"), {}, ch12::Arithmetic::single, s),
+      std::invalid_argument);
 }
 
 TEST_CASE("ch12: zero heap allocations per step after the first, with 2 threads", "[ch12]") {
@@ -195,7 +196,8 @@ double batched_against_chapter_08(const Scene& scene, const std::vector<State>& 
         reference.terms(first + l, model.tets[first + l], state, fallbacks_08, expected);
         double scale = expected.rhs.cwiseAbs().maxCoeff(), error = 0.0;
         for (int i = 0; i < 3; ++i)
-          for (int a = 0; a < 4; ++a) error = std::max(error, std::abs(terms.rhs[i][a].v[l] - expected.rhs(i, a)));
+          for (int a = 0; a < 4; ++a)
+            error = std::max(error, std::abs(terms.rhs[i][a].v[l] - expected.rhs(i, a)));
         worst = std::max(worst, error / scale);
         scale = 0.0;
         error = 0.0;
@@ -207,8 +209,10 @@ double batched_against_chapter_08(const Scene& scene, const std::vector<State>& 
             }
         worst = std::max(worst, error / scale);
         // The rotation each keeps for the next step (q and -q are the same rotation).
-        const Eigen::Quaterniond q8 = reference.rotations()[first + l], q12 = batched.rotation(first + l);
-        worst = std::max(worst, std::min((q8.coeffs() - q12.coeffs()).norm(), (q8.coeffs() + q12.coeffs()).norm()));
+        const Eigen::Quaterniond q8 = reference.rotations()[first + l],
+                                 q12 = batched.rotation(first + l);
+        worst = std::max(worst, std::min((q8.coeffs() - q12.coeffs()).norm(),
+                                         (q8.coeffs() + q12.coeffs()).norm()));
       }
     }
     reference.end_pass(fallbacks_08);
@@ -239,7 +243,8 @@ TEST_CASE("ch12: inverted and flat lanes take chapter 08's SVD path beside Newto
   // Newton: each lane keeps its own path, and the fallbacks are counted as chapter 08 counts.
   const Scene scene = test::test_scene("cantilever");
   std::mt19937 rng(7);
-  const std::vector<State> states = {turned_state(scene, rng, true), turned_state(scene, rng, true)};
+  const std::vector<State> states = {turned_state(scene, rng, true),
+                                     turned_state(scene, rng, true)};
   long long f08 = 0, f12 = 0;
   const double worst = batched_against_chapter_08(scene, states, f08, f12);
   INFO("largest relative difference " << worst << ", fallbacks " << f08 << " / " << f12);
@@ -258,5 +263,6 @@ TEST_CASE("ch12: a short batch leaves the elements past its count untouched", "[
   long long fallbacks = 0;
   batched.terms(0, 5, model.tets, state, fallbacks, terms);  // elements 0..4 only
   CHECK(batched.rotation(4).w() != 1.0);                     // element 4 turned
-  for (int e = 5; e < 2 * ch12::kLanes; ++e) CHECK(batched.rotation(e).w() == 1.0);  // still the rest
+  for (int e = 5; e < 2 * ch12::kLanes; ++e)
+    CHECK(batched.rotation(e).w() == 1.0);  // still the rest
 }

@@ -20,7 +20,8 @@ StepProfile solve_that(bool converged, double relative_residual) {
 
 }  // namespace
 
-TEST_CASE("divergence: a capped solve is a failed step only when worse than no solve", "[divergence]") {
+TEST_CASE("divergence: a capped solve is a failed step only when worse than no solve",
+          "[divergence]") {
   const State state = rest_state(test::test_scene("cantilever"));
   CHECK(divergence(state, solve_that(true, 1e-5)) == nullptr);
   CHECK(divergence(state, solve_that(false, 2e-4)) == nullptr);  // inexact: warned, counted

@@ -18,7 +18,8 @@ namespace {
 // for the next region, so a parallel region that ran on two threads leaves one more here.
 int process_threads() {
   int n = 0;
-  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/task"))
+    ++n;
   return n;
 }
 
@@ -109,9 +110,9 @@ TEST_CASE("the registry lists each variant right after its original", "[registry
     return ChapterInfo{std::move(id), "", {}, std::move(variant_of)};
   };
   // "10_mine" sorts before "10_multigrid" by name, and must still come after it.
-  const auto sorted = detail::in_course_order({info("09_threads", ""), info("10_mine", "10_multigrid"),
-                                               info("09_a", "09_threads"), info("10_multigrid", ""),
-                                               info("10_aaa", "10_multigrid")});
+  const auto sorted = detail::in_course_order(
+      {info("09_threads", ""), info("10_mine", "10_multigrid"), info("09_a", "09_threads"),
+       info("10_multigrid", ""), info("10_aaa", "10_multigrid")});
   std::vector<std::string> ids;
   for (const auto& c : sorted) ids.push_back(c.id);
   CHECK(ids == std::vector<std::string>{"09_threads", "09_a", "10_multigrid", "10_aaa", "10_mine"});
@@ -120,7 +121,8 @@ TEST_CASE("the registry lists each variant right after its original", "[registry
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (list[i].variant_of.empty()) continue;
     REQUIRE(i > 0);
-    const std::string before = list[i - 1].variant_of.empty() ? list[i - 1].id : list[i - 1].variant_of;
+    const std::string before =
+        list[i - 1].variant_of.empty() ? list[i - 1].id : list[i - 1].variant_of;
     CHECK(before == list[i].variant_of);
   }
 }

@@ -30,8 +30,7 @@ void allocations(const ChapterInfo& chapter) {
                     << "same every step)");
     CHECK(count >= 0);
     // The chapters from 06 on allocate nothing; a variant of one must keep it that way.
-    if (!chapter.variant_of.empty() &&
-        test::allocations_per_step(chapter.variant_of, scene) == 0)
+    if (!chapter.variant_of.empty() && test::allocations_per_step(chapter.variant_of, scene) == 0)
       CHECK(count == 0);
   }
 }
@@ -108,9 +107,9 @@ const bool registered = [] {
         {"the same state to the last bit on 1, 2 and 3 threads", same_state_on_any_thread_count},
         {"constrained velocities are the prescribed ones", constraints_hold}};
     for (const auto& [what, check] : checks)
-      test::register_test_case(chapter.id + ": " + what, "[every_chapter][" + chapter.id + "]",
-                               [check = check, &chapter] { check(chapter); },
-                               Catch::SourceLineInfo(__FILE__, __LINE__));
+      test::register_test_case(
+          chapter.id + ": " + what, "[every_chapter][" + chapter.id + "]",
+          [check = check, &chapter] { check(chapter); }, Catch::SourceLineInfo(__FILE__, __LINE__));
   }
   return true;
 }();
