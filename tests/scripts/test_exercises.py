@@ -207,8 +207,11 @@ def main():
         # The variants, made and changed as the READMEs say.
         originals = {}
         for ex in EXERCISES:
+            # The course's chapter, not a variant made for an earlier exercise (a variant's name
+            # can sort before its original's: 12_ex_lanes before 12_half_the_bytes).
             chapter_dir = next(d for d in sorted((repo / "chapters").iterdir())
-                               if d.name.startswith(ex["chapter"] + "_") and (d / "stepper.hpp").exists())
+                               if d.name.startswith(ex["chapter"] + "_") and (d / "stepper.hpp").exists()
+                               and not (d / "variant_of").exists())
             originals[ex["chapter"]] = chapter_dir
             check(f"{ex['id']}: the README says how to make the variant",
                   readme_has(chapter_dir, f"./tutorial.sh variant {ex['chapter']} NAME"))
