@@ -1,4 +1,5 @@
-// Chapter 12: chapter 11's step, its V-cycle on float numbers (see stepper.hpp).
+// Chapter 12: chapter 11's step with its V-cycle on float numbers and its element pass across
+// elements (see stepper.hpp).
 #include "chapters/12_half_the_bytes/stepper.hpp"
 
 #include <algorithm>
@@ -38,7 +39,8 @@ void HalfBytesStepper::element_pass(const State& state) {
   // Chapter 09's colour loop; inside a group, kLanes consecutive elements at a time, each
   // batch's terms scattered in element order, so the sums (and the state) are the same for
   // any thread count.
-  const std::vector<int>&order = colour_order(), &start = colour_start();
+  const std::vector<int>& order = colour_order();
+  const std::vector<int>& start = colour_start();
   const int group = group_size(), elements = static_cast<int>(model_.tets.size());
   long long fallbacks = 0;
   ch09::run_parallel([&] {
