@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace fem::ch12 {
 
@@ -17,14 +18,36 @@ constexpr double kMinRelativeDet = 1e-4;
 constexpr double kConvergedStep = 1e-8;
 constexpr int kMaxIterations = 12;
 
-enum : int { kIterating = 0, kConverged = 1, kFailed = -1 };
+// A lane's flags as wide as its doubles, so that a select on a flag picks between doubles
+// lane for lane.
+using Flag = std::int64_t;
+enum : Flag { kIterating = 0, kConverged = 1, kFailed = -1 };
 
 // A batch's rotations while Newton runs: the iterate q and Newton's start (kept for the lanes
 // that fall back), F, |F|^2 / 3, and each lane's status.
 struct Newton {
   Lanes q[4], start[4], F[9], scale2;
-  int status[kLanes];
+  Flag status[kLanes];
 };
+
+// A batch's lanes as an Eigen array, for the operations a plain loop cannot vectorize.
+using LaneArray = Eigen::Map<Eigen::Array<double, kLanes, 1>, Eigen::Aligned64>;
+
+// to[k].v = from[k][first .. first + kLanes - 1], for each of N arrays over the elements.
+template <std::size_t N>
+void copy_lanes(const std::array<std::vector<double>, N>& from, int first, Lanes* to) {
+  for (std::size_t k = 0; k < N; ++k) {
+    const double* in = from[k].data() + first;
+#pragma omp simd
+    for (int l = 0; l < kLanes; ++l) to[k].v[l] = in[l];
+  }
+}
+
+void copy_lanes(const std::vector<double>& from, int first, Lanes& to) {
+  const double* in = from.data() + first;
+#pragma omp simd
+  for (int l = 0; l < kLanes; ++l) to.v[l] = in[l];
+}
 
 }  // namespace
 
@@ -51,24 +74,43 @@ BatchedElements::BatchedElements(const Model& model, const Scene& scene)
 
 void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vector4i>& tets,
                             const State& state, long long& fallbacks, BatchTerms& out) {
-  // Phase 1, the gather, a scalar loop (each lane reads its own corners). Lanes past `count`
-  // repeat the last element: valid numbers, whose results are never written.
+  // Phase 1, the gather. The element's own numbers are arrays over the elements already: a
+  // full batch copies kLanes consecutive entries of each (vector loads). The corners are
+  // indexed loads, one node's x and v per corner and lane. A short batch (the end of a
+  // colour group) repeats its last element in the lanes past `count`: valid numbers, whose
+  // results are never written.
   Lanes ds[9], dv[9], dm[9], last[4], before[4], mu, lambda;
-  for (int l = 0; l < kLanes; ++l) {
-    const int e = first + std::min(l, count - 1);
-    const Eigen::Vector4i& t = tets[e];
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) {
-        ds[3 * i + j].v[l] = state.x[3 * t[j + 1] + i] - state.x[3 * t[0] + i];
-        dv[3 * i + j].v[l] = state.v[3 * t[j + 1] + i] - state.v[3 * t[0] + i];
+  int lane_element[kLanes];
+  for (int l = 0; l < kLanes; ++l) lane_element[l] = first + std::min(l, count - 1);
+  if (count == kLanes) {
+    copy_lanes(dm_, first, dm);
+    copy_lanes(rotation_, first, last);
+    copy_lanes(previous_, first, before);
+    copy_lanes(mu_volume_, first, mu);
+    copy_lanes(lambda_volume_, first, lambda);
+  } else {
+    for (int l = 0; l < kLanes; ++l) {
+      const int e = lane_element[l];
+      for (int k = 0; k < 9; ++k) dm[k].v[l] = dm_[k][e];
+      for (int c = 0; c < 4; ++c) {
+        last[c].v[l] = rotation_[c][e];
+        before[c].v[l] = previous_[c][e];
       }
-    for (int k = 0; k < 9; ++k) dm[k].v[l] = dm_[k][e];
-    for (int c = 0; c < 4; ++c) {
-      last[c].v[l] = rotation_[c][e];
-      before[c].v[l] = previous_[c][e];
+      mu.v[l] = mu_volume_[e];
+      lambda.v[l] = lambda_volume_[e];
     }
-    mu.v[l] = mu_volume_[e];
-    lambda.v[l] = lambda_volume_[e];
+  }
+  const double* x = state.x.data();
+  const double* v = state.v.data();
+  for (int l = 0; l < kLanes; ++l) {
+    const Eigen::Vector4i& t = tets[lane_element[l]];
+    for (int i = 0; i < 3; ++i) {
+      const double x0 = x[3 * t[0] + i], v0 = v[3 * t[0] + i];
+      for (int j = 0; j < 3; ++j) {
+        ds[3 * i + j].v[l] = x[3 * t[j + 1] + i] - x0;
+        dv[3 * i + j].v[l] = v[3 * t[j + 1] + i] - v0;
+      }
+    }
   }
   // From here on every loop runs over the lanes innermost, on arrays of Lanes: the form that
   // compilers vectorize without being asked twice (no calls, no branches that selects cannot
@@ -122,9 +164,9 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
   // branches as selects): R = R_q exp([w]) with H w = axial(A - A^T), A = R_q^T F. A lane that
   // converged or failed keeps its q; the converged ones are normalized after the loop.
   Lanes step[3], determinant;
-  int definite[kLanes];
+  Flag definite[kLanes];
   for (int it = 0; it < kMaxIterations; ++it) {
-    if (std::none_of(n.status, n.status + kLanes, [](int s) { return s == kIterating; })) break;
+    if (std::none_of(n.status, n.status + kLanes, [](Flag s) { return s == kIterating; })) break;
 #pragma omp simd
     for (int l = 0; l < kLanes; ++l) {
       const double w = n.q[0].v[l], x = n.q[1].v[l], y = n.q[2].v[l], z = n.q[3].v[l];
@@ -171,39 +213,62 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
 #pragma omp simd
       for (int l = 0; l < kLanes; ++l) step[k].v[l] /= determinant.v[l];
     }
+    // The Newton update for every lane, then the selects in a loop of their own: with
+    // -ftrapping-math (GCC's default) the compiler sinks arithmetic used in one arm of a select
+    // into that arm, and a floating-point operation that may trap is not executed for lanes
+    // that did not ask for it, so the loop stays scalar on AVX2 ("control flow in loop";
+    // AVX-512 masks the operation instead). A loop of loads, integer tests and selects has
+    // nothing to sink.
+    Lanes next_q[4];
+    Flag converged[kLanes];
 #pragma omp simd
     for (int l = 0; l < kLanes; ++l) {
       const double w = n.q[0].v[l], x = n.q[1].v[l], y = n.q[2].v[l], z = n.q[3].v[l];
       const double w0 = step[0].v[l], w1 = step[1].v[l], w2 = step[2].v[l];
       const double hx = 0.5 * w0, hy = 0.5 * w1, hz = 0.5 * w2;  // q * (1, w / 2)
-      const double nw = w - x * hx - y * hy - z * hz, nx = x + w * hx + y * hz - z * hy;
-      const double ny = y + w * hy - x * hz + z * hx, nz = z + w * hz + x * hy - y * hx;
-      const bool converged = w0 * w0 + w1 * w1 + w2 * w2 < kConvergedStep * kConvergedStep;
-      const int status = n.status[l];
-      const bool iterating = status == kIterating;
-      const bool update = iterating & (definite[l] != 0);
-      n.q[0].v[l] = update ? nw : w;
-      n.q[1].v[l] = update ? nx : x;
-      n.q[2].v[l] = update ? ny : y;
-      n.q[3].v[l] = update ? nz : z;
+      next_q[0].v[l] = w - x * hx - y * hy - z * hz;
+      next_q[1].v[l] = x + w * hx + y * hz - z * hy;
+      next_q[2].v[l] = y + w * hy - x * hz + z * hx;
+      next_q[3].v[l] = z + w * hz + x * hy - y * hx;
+      converged[l] = w0 * w0 + w1 * w1 + w2 * w2 < kConvergedStep * kConvergedStep;
+    }
+#pragma omp simd
+    for (int l = 0; l < kLanes; ++l) {
+      const Flag status = n.status[l];
+      const Flag iterating = status == kIterating;
+      const Flag update = iterating & definite[l];
+      for (int c = 0; c < 4; ++c) n.q[c].v[l] = update ? next_q[c].v[l] : n.q[c].v[l];
       // definite ? (converged ? kConverged : kIterating) : kFailed, as arithmetic: a nested
       // select would evaluate `converged` in one arm only, a branch again.
       static_assert(kFailed == -1 && kIterating == 0 && kConverged == 1, "the states' values");
-      const int next = int(definite[l] != 0) * (1 + int(converged)) - 1;
-      n.status[l] = iterating ? next : status;
+      const Flag next = definite[l] * (1 + converged[l]) - 1;
+      n.status[l] = status + iterating * (next - status);
     }
   }
 
-  // Phase 3, one lane at a time: the converged lanes normalized (chapter 08's q.normalize()),
-  // and where Newton could not decide (or did not converge within the cap), chapter 08's path
-  // from the same start, which ends in the SVD.
+  // Phase 3: the converged lanes normalized (chapter 08's q.normalize()), for all lanes at
+  // once: the square root through Eigen's Array, whose sqrt is the vector instruction
+  // (psqrt, Eigen/src/Core/arch/AVX/PacketMath.h), where std::sqrt in a loop stays a call
+  // because it may set errno; the quotients first, the selects in a loop of their own (see
+  // phase 2). Then, one lane at a time, the lanes where Newton could not decide (or did not
+  // converge within the cap): chapter 08's path from the same start, which ends in the SVD.
+  Lanes norm, unit[4];
+#pragma omp simd
+  for (int l = 0; l < kLanes; ++l)
+    norm.v[l] = n.q[0].v[l] * n.q[0].v[l] + n.q[1].v[l] * n.q[1].v[l] + n.q[2].v[l] * n.q[2].v[l] +
+                n.q[3].v[l] * n.q[3].v[l];
+  LaneArray(norm.v) = LaneArray(norm.v).sqrt();
+  for (int c = 0; c < 4; ++c) {
+#pragma omp simd
+    for (int l = 0; l < kLanes; ++l) unit[c].v[l] = n.q[c].v[l] / norm.v[l];
+  }
+  for (int c = 0; c < 4; ++c) {
+#pragma omp simd
+    for (int l = 0; l < kLanes; ++l)
+      n.q[c].v[l] = n.status[l] == kConverged ? unit[c].v[l] : n.q[c].v[l];
+  }
   for (int l = 0; l < count; ++l) {
-    if (n.status[l] == kConverged) {
-      const double norm = std::sqrt(n.q[0].v[l] * n.q[0].v[l] + n.q[1].v[l] * n.q[1].v[l] +
-                                    n.q[2].v[l] * n.q[2].v[l] + n.q[3].v[l] * n.q[3].v[l]);
-      for (int c = 0; c < 4; ++c) n.q[c].v[l] /= norm;
-      continue;
-    }
+    if (n.status[l] == kConverged) continue;
     Eigen::Matrix3d F;
     for (int k = 0; k < 9; ++k) F(k / 3, k % 3) = n.F[k].v[l];
     Eigen::Quaterniond q(n.start[0].v[l], n.start[1].v[l], n.start[2].v[l], n.start[3].v[l]);
@@ -211,11 +276,21 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
     const double c[4] = {q.w(), q.x(), q.y(), q.z()};
     for (int k = 0; k < 4; ++k) n.q[k].v[l] = c[k];
   }
-  for (int l = 0; l < count; ++l) {  // the next step's start, as chapter 08 keeps it
-    const int e = first + l;
-    for (int c = 0; c < 4; ++c) {
-      previous_[c][e] = first_step_ ? n.q[c].v[l] : rotation_[c][e];
-      rotation_[c][e] = n.q[c].v[l];
+  // The next step's start, as chapter 08 keeps it: this step's rotation and the last one.
+  for (int c = 0; c < 4; ++c) {
+    double* previous = previous_[c].data() + first;
+    double* rotation = rotation_[c].data() + first;
+    if (count == kLanes) {
+#pragma omp simd
+      for (int l = 0; l < kLanes; ++l) {
+        previous[l] = first_step_ ? n.q[c].v[l] : last[c].v[l];
+        rotation[l] = n.q[c].v[l];
+      }
+    } else {
+      for (int l = 0; l < count; ++l) {
+        previous[l] = first_step_ ? n.q[c].v[l] : last[c].v[l];
+        rotation[l] = n.q[c].v[l];
+      }
     }
   }
 

@@ -52,20 +52,44 @@ constexpr int Lanes = R == 3 ? 4 : 8;
 template <class Real, int R>
 using Wide = Eigen::Matrix<Real, Lanes<R>, 1>;
 
+// Partial sums of a product, in float one per block column: a block's columns then add into
+// independent registers. With one sum, the C multiply-adds of a block form a chain in which
+// each waits for the last (4 cycles each on current x86 cores) while the core could start two
+// per cycle: the products of a cache-resident level are bound by that latency, not by bytes.
+// In double a column of Wide takes twice the registers, and C sums of them spill (AVX2 has 16
+// vector registers): one sum there.
 template <class Real, int R, int C>
-EIGEN_ALWAYS_INLINE void add_product(Wide<Real, R>& acc, const Eigen::Matrix<float, R, C>& M,
+struct Sums {
+  static constexpr int kSplit = std::is_same_v<Real, float> ? C : 1;
+  Wide<Real, R> column[kSplit];
+
+  static Sums Zero() {
+    Sums s;
+    for (auto& c : s.column) c.setZero();
+    return s;
+  }
+  Eigen::Matrix<Real, R, 1> total() const {
+    Wide<Real, R> sum = column[0];
+    for (int j = 1; j < kSplit; ++j) sum += column[j];
+    return sum.template head<R>();
+  }
+};
+
+template <class Real, int R, int C>
+EIGEN_ALWAYS_INLINE void add_product(Sums<Real, R, C>& sums, const Eigen::Matrix<float, R, C>& M,
                                      const Real* x) {
   using Column = Eigen::Matrix<float, Lanes<R>, 1>;
   for (int j = 0; j < C; ++j)
-    acc += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];
+    sums.column[j % Sums<Real, R, C>::kSplit] +=
+        Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];
 }
 
-// sum of A_k x_(column k) over the blocks [begin, end) of a row, in two independent sums (as
-// chapter 10's row_product), so that the products of a row overlap.
+// sum of A_k x_(column k) over the blocks [begin, end) of a row: 2 B independent sums (two
+// blocks at a time, as chapter 10's row_product, and a sum per block column).
 template <class Real, int B>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> row_product(const ReducedLevel<Real, B>& level,
                                                           const Real* x, int begin, int end) {
-  Wide<Real, B> even = Wide<Real, B>::Zero(), odd = Wide<Real, B>::Zero();
+  auto even = Sums<Real, B, B>::Zero(), odd = Sums<Real, B, B>::Zero();
   const int* column = level.source->A.column.data();
   const Eigen::Matrix<float, B, B>* blocks = level.blocks.data();
   int k = begin;
@@ -74,15 +98,15 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> row_product(const ReducedLevel<Rea
     add_product(odd, blocks[k + 1], x + B * column[k + 1]);
   }
   if (k < end) add_product(even, blocks[k], x + B * column[k]);
-  return (even + odd).template head<B>();
+  return even.total() + odd.total();
 }
 
 template <class Real, int B>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> times_inverse_diagonal(
     const ReducedLevel<Real, B>& level, int i, const Eigen::Matrix<Real, B, 1>& r) {
-  Wide<Real, B> out = Wide<Real, B>::Zero();
+  auto out = Sums<Real, B, B>::Zero();
   add_product(out, level.inverse_diagonal[i], r.data());
-  return out.template head<B>();
+  return out.total();
 }
 
 // Chapter 10's polynomial_step: d = alpha d + beta D^-1 (b - A in), out = in + d.
@@ -125,10 +149,10 @@ void restrict_rows(const ReducedLevel<Real, B>& level, ReducedLevel<Real, kModes
                    int first, int last) {
   const auto& PT = level.source->PT;
   for (int c = first; c < last; ++c) {
-    Wide<Real, kModes> sum = Wide<Real, kModes>::Zero();
+    auto sum = Sums<Real, kModes, B>::Zero();
     for (int e = PT.row_start[c]; e < PT.row_start[c + 1]; ++e)
       add_product(sum, level.PT[e], level.work.data() + B * PT.column[e]);
-    coarse.b.template segment<kModes>(kModes * c) = sum.template head<kModes>();
+    coarse.b.template segment<kModes>(kModes * c) = sum.total();
   }
 }
 
@@ -138,11 +162,10 @@ void prolong_rows(ReducedLevel<Real, B>& level, const ReducedLevel<Real, kModes>
                   int last, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
   const auto& P = level.source->P;
   for (int i = first; i < last; ++i) {
-    Wide<Real, B> sum = Wide<Real, B>::Zero();
-    sum.template head<B>() = x.template segment<B>(B * i);
+    auto sum = Sums<Real, B, kModes>::Zero();
     for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
       add_product(sum, level.P[m], coarse.x.data() + kModes * P.column[m]);
-    level.y.template segment<B>(B * i) = sum.template head<B>();
+    level.y.template segment<B>(B * i) = x.template segment<B>(B * i) + sum.total();
   }
 }
 
