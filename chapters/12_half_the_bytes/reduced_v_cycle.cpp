@@ -68,6 +68,7 @@ struct Sums {
     for (auto& c : s.column) c.setZero();
     return s;
   }
+  Wide<Real, R>& of(int j) { return column[j % kSplit]; }  // block column j's sum
   Eigen::Matrix<Real, R, 1> total() const {
     Wide<Real, R> sum = column[0];
     for (int j = 1; j < kSplit; ++j) sum += column[j];
@@ -80,8 +81,7 @@ EIGEN_ALWAYS_INLINE void add_product(Sums<Real, R, C>& sums, const Eigen::Matrix
                                      const Real* x) {
   using Column = Eigen::Matrix<float, Lanes<R>, 1>;
   for (int j = 0; j < C; ++j)
-    sums.column[j % Sums<Real, R, C>::kSplit] +=
-        Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];
+    sums.of(j) += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];
 }
 
 // sum of A_k x_(column k) over the blocks [begin, end) of a row: 2 B independent sums (two

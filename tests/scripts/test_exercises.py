@@ -130,8 +130,9 @@ EXERCISES = [
     {"id": "12/2", "chapter": "12", "name": "ex_unpadded",
      "change": [("reduced_v_cycle.cpp",
                  "  using Column = Eigen::Matrix<float, Lanes<R>, 1>;\n  for (int j = 0; j < C; ++j)\n"
-                 "    acc += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];\n",
-                 "  for (int j = 0; j < C; ++j) acc.template head<R>() += M.col(j).template cast<Real>() * x[j];\n")],
+                 "    sums.of(j) += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];\n",
+                 "  for (int j = 0; j < C; ++j)\n"
+                 "    sums.of(j).template head<R>() += M.col(j).template cast<Real>() * x[j];\n")],
      "bench": "build/release/fem_bench --chapters 12,12_NAME --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons half-the-bytes --chapter 12_NAME"},
