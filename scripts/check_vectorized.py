@@ -95,6 +95,10 @@ def main():
     if not loops:
         sys.exit(f"check_vectorized: {source} has no `#pragma omp simd` loop")
     done, missed = report(build_dir, source)
+    if not done:
+        # Not one loop of the file reported vectorized: the report was not read (another
+        # format, or no optimization), and silence would pass every loop.
+        sys.exit(f"check_vectorized: GCC reported no vectorized loop in {source.name}")
     failed = 0
     for first, last in loops:
         inside = range(first, last + 1)
