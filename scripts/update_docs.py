@@ -3,8 +3,9 @@
 comments (never typed by hand):
 
   docs/results.md          results:machine, results:phases, results:speedups,
-                           results:allocations, results:solvers, results:scaling
-  README.md                headline, chapter-map, viewer-fps (from results/viewer.json)
+                           results:allocations, results:solvers, results:scaling, and
+                           viewer-fps (from results/viewer.json)
+  README.md                headline, chapter-map
   regime sweep             regimes:poster, regimes:points, regimes:solvers in docs/results.md and
                            regimes:poster in README.md (from results/regimes.json, copied to
                            docs/data/regimes.json; without it, from docs/data/regimes.json)
@@ -496,10 +497,9 @@ def main():
         print(f"no {scaling_path}: the scaling table in docs/results.md is left as it is")
     stale = [] if args.check else None
     update_file(root / "docs" / "results.md", tables, stale)
-    readme = {"headline": headline(data), "chapter-map": chapter_map(data)}
+    update_file(root / "README.md", {"headline": headline(data), "chapter-map": chapter_map(data)}, stale)
     if viewer is not None:  # like the scaling table: optional, kept as it is without a new run
-        readme["viewer-fps"] = viewer_table(viewer)
-    update_file(root / "README.md", readme, stale)
+        update_file(root / "docs" / "results.md", {"viewer-fps": viewer_table(viewer)}, stale)
     for c in data["chapters"]:
         update_file(root / "chapters" / chapter_dir(c["chapter"]) / "README.md",
                     {f"bench-table:{c['chapter']}": chapter_table(data, c["chapter"]),
