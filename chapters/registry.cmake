@@ -2,7 +2,7 @@
 # a chapter, found by the build, so adding a chapter (or a variant, ./tutorial.sh variant)
 # edits no list. The convention it reads (chapters/README.md):
 #   stepper.hpp  declares the stepper inside `namespace fem::<ns> {` as
-#                `class <Name> final : public Stepper` (or `public chNN::<Name>Stepper`, a chapter's
+#                `class <Name> [final] : public Stepper` (or `public chNN::<Name>Stepper`, a chapter's
 #                stepper it extends), constructible from (Scene, SolverSettings);
 #   README.md    starts with `# Chapter NN: <title>`, the title the apps and the results show;
 #   variant_of   (variants only) one line, the id of the chapter it was copied from.
@@ -72,7 +72,7 @@ foreach(header ${headers})
          steppers "${text}")
   list(LENGTH steppers count)
   if(NOT count EQUAL 1)
-    fem_fail(${dir} "stepper.hpp declares ${count} classes `class <Name> final : public Stepper`, not one")
+    fem_fail(${dir} "stepper.hpp declares ${count} classes `class <Name> [final] : public Stepper`, not one")
   endif()
   string(REGEX REPLACE "^class[ \t\r\n]+([A-Za-z0-9_]+).*" "\\1" class "${steppers}")
   file(STRINGS ${SOURCE_DIR}/chapters/${dir}/README.md heading LIMIT_COUNT 1)

@@ -6,8 +6,10 @@ added, and so does a file that includes its namesake of the previous chapter (ch
 stepper extends chapter 09's instead of copying it), as do the lesson measurements
 (lesson.hpp, lesson.cpp), which never copy forward. Before diffing, the previous chapter's
 text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
-header's path, "Chapter NN"), so that no hunk is a rename. With --check, writes nothing and
-exits 1 if a committed diff is stale or any hunk only changes names.
+header's path, "Chapter NN"), so that no hunk is a rename. It also writes the table of each
+chapter's files and what it includes from earlier chapters into chapters/README.md (between
+its chapter-files markers). With --check, writes nothing and exits 1 if a committed diff or
+that table is stale or any hunk only changes names.
 
     .venv/bin/python scripts/chapter_diffs.py                    # regenerate
     .venv/bin/python scripts/chapter_diffs.py --check            # compare with the committed ones
@@ -131,6 +133,33 @@ def variant_diff(root, variant):
     return "".join(out)
 
 
+INCLUDE = re.compile(r'#include "chapters/(\d\d_\w+)/([\w.]+)"')
+FILES_MARKER = "chapter-files"
+
+
+def files_table(dirs):
+    """Per chapter, its source files and the files of earlier chapters it includes (what a
+    student opens in the earlier chapter's folder), from the sources themselves."""
+    rows = ["| chapter | its files (besides `README.md`) | includes from earlier chapters |",
+            "| --- | --- | --- |"]
+    for chapter in dirs:
+        own = ", ".join(f"`{p.name}`" for p in source_files(chapter))
+        included = sorted({m.groups() for p in source_files(chapter)
+                           for m in INCLUDE.finditer(p.read_text()) if m.group(1) != chapter.name})
+        earlier = ", ".join(f"{c[:2]}'s `{f}`" for c, f in included)
+        rows.append(f"| {chapter.name[:2]} | {own} | {earlier} |")
+    return "\n".join(rows) + "\n"
+
+
+def with_files_table(text, table):
+    """chapters/README.md's text with the table between its markers (None: no markers)."""
+    begin, end = f"<!-- {FILES_MARKER}:begin -->", f"<!-- {FILES_MARKER}:end -->"
+    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
+    if not pattern.search(text):
+        return None
+    return pattern.sub(lambda _: begin + "\n" + table + end, text)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true", help="only check that the diffs are current")
@@ -154,11 +183,23 @@ def main():
             out_dir.mkdir(parents=True, exist_ok=True)
             path.write_text(text)
             print(f"wrote {path.relative_to(args.root)} ({text.count(chr(10))} lines)")
+    readme = args.root / "chapters" / "README.md"
+    text = readme.read_text() if readme.exists() else ""
+    new = with_files_table(text, files_table(dirs))
+    if new is None:
+        print(f"{readme}: no {FILES_MARKER} markers", file=sys.stderr)
+        return 1
+    if new != text:
+        if args.check:
+            stale.append(readme)
+        else:
+            readme.write_text(new)
+            print(f"wrote the {FILES_MARKER} table of {readme.relative_to(args.root)}")
     if renames:
         print("hunks that only change names (normalise them in renamed()):\n  " + "\n  ".join(renames),
               file=sys.stderr)
     if stale:
-        print("stale chapter diffs (run scripts/chapter_diffs.py):\n  " +
+        print("stale chapter diffs or files table (run scripts/chapter_diffs.py):\n  " +
               "\n  ".join(str(p.relative_to(args.root)) for p in stale), file=sys.stderr)
     if stale or renames:
         return 1

@@ -11,8 +11,8 @@
 //
 // Two classic orders, both computed once from the mesh:
 // - reverse Cuthill-McKee (Cuthill & McKee 1969; reversed by George 1971): a breadth-first
-//   search from a node at the end of the mesh (a pseudo-peripheral node, Gibbs, Poole &
-//   Stockmeyer 1976), neighbours in increasing degree. Each level of the search is a slice
+//   search from a node at the end of the mesh (a pseudo-peripheral node, found as George &
+//   Liu 1979 find it), neighbours in increasing degree. Each level of the search is a slice
 //   across the body, so neighbours get numbers at most about one slice apart: a small
 //   bandwidth;
 // - a space-filling curve (Morton's Z-order on the rest positions): nodes close in space get
