@@ -74,6 +74,22 @@ def main():
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
                   f"{f} missing or small")
+        # The figures of chapters 10-12 from the committed data (docs/data/figures/) and
+        # chapter 12's sources; a mesh numbered otherwise than the code's record is refused.
+        p = run(SCRIPTS / "figures.py", "--out", out)
+        check("figures.py exits 0", p.returncode == 0, p.stderr)
+        for png in ["vcycle", "aggregates", "node_orders", "padded_lanes", "soa_batch"]:
+            f = out / f"{png}.png"
+            check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
+                  f"{f} missing or small")
+        data = tmp / "figures"
+        data.mkdir()
+        record = json.loads((ROOT / "docs" / "data" / "figures" / "hierarchy.json").read_text())
+        record["tet_checksum"] += 1
+        (data / "hierarchy.json").write_text(json.dumps(record))
+        p = run(SCRIPTS / "figures.py", "hierarchy", "--data", data, "--out", out)
+        check("figures.py refuses a mesh not numbered as the code's record",
+              p.returncode == 2 and "not numbered here" in p.stderr, p.stderr)
         p = run(SCRIPTS / "plot_results.py", tmp / "missing.json", "--out", out)
         check("plot_results.py on a missing file exits 2 with a message",
               p.returncode == 2 and "no such file" in p.stderr, p.stderr)
