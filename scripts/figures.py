@@ -19,6 +19,7 @@ import argparse
 import pathlib
 import re
 import sys
+import textwrap
 
 import matplotlib
 
@@ -40,8 +41,9 @@ PALETTE = list(matplotlib.colormaps["tab10"].colors) + list(matplotlib.colormaps
 
 def finish(fig, path, note, top=0.95, left=0.0):
     """The note on the figure's data at the bottom left, the layout, the file."""
-    fig.text(0.01, 0.008, note, fontsize=7.5, color="0.35")
-    fig.tight_layout(rect=(left, 0.03, 1, top))
+    lines = textwrap.wrap(note, int(16 * fig.get_figwidth()))  # about 16 characters an inch
+    fig.text(0.01, 0.008, "\n".join(lines), fontsize=7.5, color="0.35")
+    fig.tight_layout(rect=(left, (0.1 + 0.14 * len(lines)) / fig.get_figheight(), 1, top))
     fig.savefig(path, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
