@@ -59,12 +59,14 @@ commands:
   docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
-             tables (fem_lessons), the chapter diffs (docs/diffs/) and the viewer's screenshot
+             tables (fem_lessons), the figures of chapters 10-12 (scripts/figures.py), the
+             chapter diffs (docs/diffs/) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
   lessons    measure the lesson tables (fem_lessons, scripts/pyamg_reference.py; a few minutes),
              record them in docs/data/lessons/*.json and write them into the chapter READMEs
-             (ctest -L docs checks that the READMEs hold the recorded tables); part of docs
+             (ctest -L docs checks that the READMEs hold the recorded tables), and the data of
+             the figures (fem_figure_data: docs/data/figures/*.json); part of docs
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   viewer-bench
@@ -316,6 +318,12 @@ lessons() {
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   "$VENV/bin/python" scripts/lesson_tables.py
+  # The code's own data behind the figures of chapters 10 and 11 (scripts/figures.py draws them).
+  mkdir -p docs/data/figures
+  "$BUILD_DIR/fem_figure_data" hierarchy --mesh meshes/plate_poster.msh \
+    --json docs/data/figures/hierarchy.json
+  "$BUILD_DIR/fem_figure_data" node-orders --mesh meshes/beam_10k.msh \
+    --json docs/data/figures/node-orders.json
 }
 
 docs() {
@@ -335,6 +343,8 @@ docs() {
     "$VENV/bin/python" scripts/plot_results.py --threads docs/data/threads.json --out docs/images
   fi
   if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
+  log "figures of chapters 10-12 (scripts/figures.py, from docs/data/figures/ and the code)"
+  "$VENV/bin/python" scripts/figures.py --out docs/images
   "$VENV/bin/python" scripts/update_docs.py
   log "chapter diffs (docs/diffs/)"
   "$VENV/bin/python" scripts/chapter_diffs.py

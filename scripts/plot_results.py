@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Plots the benchmark results: from results/bench.json only (no numbers typed here).
 
-    plot_results.py results/bench.json --out results       phases, speedup, allocations, solvers
+    plot_results.py results/bench.json --out results       phases (grouped, stacked), speedup,
+                                                            allocations, solvers
     plot_results.py --scaling results/scaling.json --out results     scaling
     plot_results.py --threads results/threads.json --out results     threads (thread scaling)
 """
@@ -85,6 +86,52 @@ def plot_phases(data, out):
     legend_outside(ax, "0: a phase at 0 ms, no bar" if zeros else None)
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "phases.png")
+
+
+# The phases of the stacked bars, left to right, and their colours (one per phase, not per chapter).
+STACK_COLORS = {"forces": "tab:gray", "dfdx": "tab:orange", "compose": "tab:green",
+                "constraints": "tab:red", "solve": "tab:blue", "rest": "0.8"}
+
+
+def stacked_rows(data):
+    """Per row of the run: (label, the phases' medians in STACK_COLORS's order, the step's
+    median). "rest" is the step's median minus the phases' medians (the state update, the
+    profiling itself, and the difference between a median of sums and a sum of medians),
+    never drawn below 0."""
+    rows = []
+    for c in data["chapters"]:
+        med = c["median_ms"]
+        parts = [med["forces"], med["dfdx"], med["compose"], med["constraints"], med["solve"]]
+        rows.append((c["chapter"], parts + [max(med["step"] - sum(parts), 0.0)], med["step"]))
+    return rows
+
+
+def plot_phases_stacked(data, out):
+    """The course at a glance: one bar per row (chapter, and chapter@threads), the step split
+    into its phases, with the step's median and its speedup over the first row at the end."""
+    rows = stacked_rows(data)
+    fig, ax = plt.subplots(figsize=(11, 0.36 * len(rows) + 2.2))
+    y = np.arange(len(rows))
+    left = np.zeros(len(rows))
+    for k, phase in enumerate(STACK_COLORS):
+        widths = np.array([r[1][k] for r in rows])
+        label = PHASE_LABELS.get(phase, "rest of the step")
+        if phase == "forces":
+            label = "forces (from 08: the fused element pass)"
+        ax.barh(y, widths, left=left, color=STACK_COLORS[phase], label=label, height=0.72)
+        left += widths
+    base = rows[0][2]
+    for yi, (_, _, step) in zip(y, rows):
+        ax.annotate(f"{step:.1f} ms" + (f"  x{base / step:.1f}" if yi > 0 else ""), (step, yi),
+                    xytext=(4, 0), textcoords="offset points", va="center", fontsize=8)
+    ax.set_yticks(y, [r[0] for r in rows], fontsize=9)
+    ax.invert_yaxis()
+    ax.set_xlim(0, 1.15 * max(r[2] for r in rows))
+    ax.set_xlabel(f"median time per step [ms]; at the end: the step and its speedup over {rows[0][0]}")
+    ax.set_title(f"The course at a glance: the step split into its phases ({run_label(data)})")
+    ax.legend(fontsize=8, loc="lower right", title="phase (median per step)", title_fontsize=8)
+    ax.grid(axis="x", alpha=0.3)
+    finish(fig, data, out / "phases_stacked.png")
 
 
 def speedup_references(data):
@@ -323,6 +370,7 @@ def main():
             print(f"plots of {args.bench}: {run_label(data)}, "
                   f"{', '.join(c['chapter'] for c in data['chapters'])}")
             plot_phases(data, out)
+            plot_phases_stacked(data, out)
             plot_speedup(data, out)
             plot_allocations(data, out)
             plot_solvers(data, out)

@@ -220,7 +220,9 @@ def headline(data):
                      ratio(base["median_ms"]["step"], c["median_ms"]["step"]) if base else "-",
                      f"{c['allocations_per_step']:g}"])
     mesh, b = data["mesh"], data["build"]
-    return ("![Speedup per phase over chapter 01, beside the poster's](docs/images/speedup.png)\n\n" +
+    return ("![The course at a glance: each chapter's step split into its phases]"
+            "(docs/images/phases_stacked.png)\n\n"
+            "![Speedup per phase over chapter 01, beside the poster's](docs/images/speedup.png)\n\n" +
             table(["chapter", "step (ms, median)", "speedup over 01", "allocations per step"], rows) +
             f"\nMeasured by `./tutorial.sh bench` on {mesh['file']} ({mesh['nodes']} nodes, "
             f"{mesh['tets']} tets), {data['scene']} scene, {data['machine']['cpu']}, "

@@ -70,10 +70,26 @@ def main():
         check("plot_results.py exits 0", p.returncode == 0, p.stderr)
         p = run(SCRIPTS / "plot_results.py", "--threads", FIXTURE, "--out", out)
         check("plot_results.py --threads exits 0", p.returncode == 0, p.stderr)
-        for png in ["phases", "speedup", "allocations", "solvers", "scaling", "threads"]:
+        for png in ["phases", "phases_stacked", "speedup", "allocations", "solvers", "scaling", "threads"]:
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
                   f"{f} missing or small")
+        # The figures of chapters 10-12 from the committed data (docs/data/figures/) and
+        # chapter 12's sources; a mesh numbered otherwise than the code's record is refused.
+        p = run(SCRIPTS / "figures.py", "--out", out)
+        check("figures.py exits 0", p.returncode == 0, p.stderr)
+        for png in ["vcycle", "aggregates", "node_orders", "padded_lanes", "soa_batch"]:
+            f = out / f"{png}.png"
+            check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
+                  f"{f} missing or small")
+        data = tmp / "figures"
+        data.mkdir()
+        record = json.loads((ROOT / "docs" / "data" / "figures" / "hierarchy.json").read_text())
+        record["tet_checksum"] += 1
+        (data / "hierarchy.json").write_text(json.dumps(record))
+        p = run(SCRIPTS / "figures.py", "hierarchy", "--data", data, "--out", out)
+        check("figures.py refuses a mesh not numbered as the code's record",
+              p.returncode == 2 and "not numbered here" in p.stderr, p.stderr)
         p = run(SCRIPTS / "plot_results.py", tmp / "missing.json", "--out", out)
         check("plot_results.py on a missing file exits 2 with a message",
               p.returncode == 2 and "no such file" in p.stderr, p.stderr)
@@ -102,6 +118,13 @@ def main():
         pairs, ylabel, _ = plot_results.speedup_references(two)
         check("a run without 01 and without variants compares with its first row",
               len(pairs) == 1 and pairs[0][1] is two["chapters"][0], ylabel)
+        # The stacked bars: every row of the run, each as long as its step (the rest fills the
+        # gap between the phases' medians and the step's), or as its phases when they exceed it.
+        rows = plot_results.stacked_rows(bench)
+        check("one stacked bar per row, each reaching its step",
+              [r[0] for r in rows] == [c["chapter"] for c in bench["chapters"]] and
+              all(min(p) >= 0 and abs(sum(p) - max(step, sum(p[:-1]))) < 1e-9 for _, p, step in rows),
+              str(rows[:2]))
         check("rows on two threads are hatched, rows on one are not",
               all((plot_results.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
                   for c in bench["chapters"]) and any(c.get("threads", 1) > 1 for c in bench["chapters"]))
