@@ -6,78 +6,119 @@
 
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
+#include "common/deformation.hpp"
 #include "common/vtk.hpp"
 
-int main(int argc, char** argv) {
-  using namespace fem;
-  ArgParser args("fem_sim", "Simulates a scene with one chapter's stepper and writes VTK frames.");
+namespace {
+
+using namespace fem;
+
+struct Run {
+  const ChapterInfo* chapter = nullptr;
+  int steps = 0, every = 0, threads = 1;
+  SolverSettings solver;
+};
+
+void add_options(ArgParser& args) {
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
   add_thread_option(args);
   args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", latest_chapter().id);
   args.option("steps", "N", "number of time steps, > 0", "200");
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
-  args.option("out", "DIR", "directory for the .vtu frames and the .pvd series", "out/sim");
+  args.option("out", "DIR",
+              "directory for the .vtu frames and the .pvd series (an earlier series of the "
+              "scene's name there is replaced)",
+              "out/sim");
+}
+
+// Every argument checked before the work; the output folder is checked, not yet made.
+Run run_from_args(const ArgParser& args) {
+  Run run;
+  try {
+    run.chapter = &find_chapter(args.get("chapter"));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  run.steps = args.get_int("steps");
+  run.every = args.get_int("every");
+  if (run.steps <= 0) throw UsageError("--steps must be positive");
+  if (run.every < 0) throw UsageError("--every must be >= 0");
+  run.solver = solver_from_args(args);
+  run.threads = threads_from_args(args);
+  if (run.every > 0) {
+    try {
+      VtkSeries::check_writable(args.get("out"));
+    } catch (const std::runtime_error& e) {
+      throw UsageError(std::string("--out: ") + e.what());
+    }
+  }
+  return run;
+}
+
+void print_progress(int k, const Run& run, const Scene& scene, const StepProfile& p) {
+  std::cout << "  step " << k << "/" << run.steps << "  t = " << k * scene.dt << " s  step "
+            << p.step.seconds * 1e3 << " ms  CG " << p.cg_iterations << " it  residual "
+            << p.relative_residual << "\n";
+}
+
+// The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
+// for a step that diverged (an error) or left the body implausible (counted).
+void simulate(const Run& run, const Scene& scene, Stepper& stepper,
+              std::optional<VtkSeries>& series) {
+  State state = rest_state(scene);
+  if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+  DeformationReport deformation;
+  const int report_every = std::max(1, run.steps / 10);
+  for (int k = 1; k <= run.steps; ++k) {
+    stepper.step(state);
+    if (const char* why = divergence(state, stepper.profile()))
+      throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" + why +
+                               "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
+    deformation.after_step(k, check_deformation(scene.mesh, state.x));
+    if (series && k % run.every == 0)
+      series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+    if (k % report_every == 0 || k == run.steps) print_progress(k, run, scene, stepper.profile());
+  }
+  deformation.summary(run.steps);
+}
+
+void run_scene(const ArgParser& args, const Run& run) {
+  const Scene scene = scene_from_args(args);
+  std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
+            << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
+            << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s\n";
+  auto stepper = run.chapter->make(scene, run.solver);
+  std::cout << "threads: " << (stepper->uses_threads() ? run.threads : 1)
+            << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";
+  std::optional<VtkSeries> series;
+  if (run.every > 0) {
+    series.emplace(args.get("out"), args.get("scene"));
+    if (series->replaced_frames() > 0)
+      std::cout << "replacing the earlier series '" << args.get("scene") << "' in "
+                << args.get("out") << " (" << series->replaced_frames() << " frames removed)\n";
+  }
+  const auto start = std::chrono::steady_clock::now();
+  simulate(run, scene, *stepper, series);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "done in " << seconds << " s";
+  if (series)
+    std::cout << "; " << series->frames() << " frames, open " << series->pvd_path()
+              << " in ParaView";
+  std::cout << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fem::ArgParser args("fem_sim",
+                      "Simulates a scene with one chapter's stepper and writes VTK frames.");
+  add_options(args);
   try {
     if (!args.parse(argc, argv)) return 0;
-    const ChapterInfo* found = nullptr;
-    try {
-      found = &find_chapter(args.get("chapter"));
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
-    const ChapterInfo& chapter = *found;
-    const int steps = args.get_int("steps");
-    const int every = args.get_int("every");
-    if (steps <= 0) throw UsageError("--steps must be positive");
-    if (every < 0) throw UsageError("--every must be >= 0");
-    const SolverSettings solver = solver_from_args(args);
-    const int threads = threads_from_args(args);
-    // The output folder before the mesh and the steps: a place it cannot write fails at once.
-    std::optional<VtkSeries> series;
-    if (every > 0) {
-      try {
-        series.emplace(args.get("out"), args.get("scene"));
-      } catch (const std::runtime_error& e) {
-        throw UsageError(std::string("--out: ") + e.what());
-      }
-    }
-    const Scene scene = scene_from_args(args);
-
-    std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
-              << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
-              << chapter.id << ", " << steps << " steps of " << scene.dt << " s\n";
-    auto stepper = chapter.make(scene, solver);
-    std::cout << "threads: " << (stepper->uses_threads() ? threads : 1)
-              << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";
-    State state = rest_state(scene);
-    if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
-
-    const auto start = std::chrono::steady_clock::now();
-    const int report_every = std::max(1, steps / 10);
-    for (int k = 1; k <= steps; ++k) {
-      stepper->step(state);
-      if (const char* why = divergence(state, stepper->profile()))
-        throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" +
-                                 why +
-                                 "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
-      if (series && k % every == 0)
-        series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
-      if (k % report_every == 0 || k == steps) {
-        const StepProfile& p = stepper->profile();
-        std::cout << "  step " << k << "/" << steps << "  t = " << k * scene.dt << " s  step "
-                  << p.step.seconds * 1e3 << " ms  CG " << p.cg_iterations << " it  residual "
-                  << p.relative_residual << "\n";
-      }
-    }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "done in " << seconds << " s";
-    if (series)
-      std::cout << "; " << series->frames() << " frames, open " << series->pvd_path()
-                << " in ParaView";
-    std::cout << "\n";
-  } catch (const UsageError& e) {
+    run_scene(args, run_from_args(args));
+  } catch (const fem::UsageError& e) {
     std::cerr << "fem_sim: " << e.what() << " (see fem_sim --help)\n";
     return 2;
   } catch (const std::exception& e) {

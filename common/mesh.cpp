@@ -54,23 +54,38 @@ void reset_gmsh() {
   gmsh_initialized = false;
 }
 
-}  // namespace
+// How a message names node i and tetrahedron e: by the file's tags when the mesh came from a
+// file (gmsh numbers from 1 and may skip numbers), else by position.
+std::string node_name(const MeshTags& tags, Eigen::Index i) {
+  if (static_cast<std::size_t>(i) < tags.node.size())
+    return "node " + std::to_string(tags.node[static_cast<std::size_t>(i)]) + " (tag in the file)";
+  return "node " + std::to_string(i);
+}
 
-TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const std::string& name) {
+std::string tet_name(const MeshTags& tags, std::size_t e) {
+  if (e < tags.tet.size())
+    return "tetrahedron " + std::to_string(tags.tet[e]) + " (element tag in the file)";
+  return "tetrahedron " + std::to_string(e);
+}
+
+void check_arrays(const Eigen::Matrix3Xd& X, const std::vector<Eigen::Vector4i>& tets,
+                  const std::string& name, const MeshTags& tags) {
   if (tets.empty())
     fail(name, "no tetrahedra (a file whose only physical group is a surface saves none)");
   if (!X.allFinite()) {
     Eigen::Index bad = 0;
     while (X.col(bad).allFinite()) ++bad;
-    fail(name, "node " + std::to_string(bad) + " has a NaN or infinite coordinate");
+    fail(name, node_name(tags, bad) + " has a NaN or infinite coordinate");
   }
-  for (const auto& t : tets)
+  for (std::size_t e = 0; e < tets.size(); ++e)
     for (int i = 0; i < 4; ++i)
-      if (t[i] < 0 || t[i] >= X.cols()) fail(name, "a tetrahedron refers to a missing node");
+      if (tets[e][i] < 0 || tets[e][i] >= X.cols())
+        fail(name, tet_name(tags, e) + " refers to a missing node");
+}
 
-  TetMesh mesh;
-  mesh.file = name;
-  // Drop unused nodes and renumber densely.
+// Drops the nodes no tetrahedron uses and renumbers the rest densely, in their order.
+void drop_unused_nodes(const Eigen::Matrix3Xd& X, std::vector<Eigen::Vector4i>& tets,
+                       TetMesh& mesh) {
   std::vector<int> new_index(static_cast<std::size_t>(X.cols()), -1);
   int used = 0;
   for (const auto& t : tets)
@@ -84,7 +99,10 @@ TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const s
     if (new_index[i] >= 0) mesh.X.col(new_index[i]) = X.col(i);
   for (auto& t : tets)
     for (int i = 0; i < 4; ++i) t[i] = new_index[t[i]];
+}
 
+// Refuses flat tetrahedra and turns inverted ones (counted) so that det(Dm) > 0.
+void orient_tets(std::vector<Eigen::Vector4i>& tets, TetMesh& mesh, const MeshTags& tags) {
   for (std::size_t e = 0; e < tets.size(); ++e) {
     auto& t = tets[e];
     const double vol6 = signed_volume6(mesh.X, t);
@@ -92,13 +110,24 @@ TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const s
     // Relative to the element's size: a sliver whose volume is 1e-10 of a cube on
     // its longest edge is numerically flat and would make Dm singular.
     if (!(std::abs(vol6) > 1e-10 * l * l * l))
-      fail(name, "tetrahedron " + std::to_string(e) + " is degenerate (volume " +
-                     std::to_string(vol6 / 6.0) + ")");
+      fail(mesh.file,
+           tet_name(tags, e) + " is degenerate (volume " + std::to_string(vol6 / 6.0) + ")");
     if (vol6 < 0.0) {
       std::swap(t[2], t[3]);
       ++mesh.reoriented_tets;
     }
   }
+}
+
+}  // namespace
+
+TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const std::string& name,
+                  const MeshTags& tags) {
+  check_arrays(X, tets, name, tags);
+  TetMesh mesh;
+  mesh.file = name;
+  drop_unused_nodes(X, tets, mesh);
+  orient_tets(tets, mesh, tags);
   mesh.tets = std::move(tets);
   mesh.boundary = boundary_triangles(mesh.tets);
   return mesh;
@@ -139,21 +168,28 @@ TetMesh load_mesh(const std::string& path) {
             [&](std::size_t a, std::size_t b) { return node_tags[a] < node_tags[b]; });
   std::unordered_map<std::size_t, int> index_of_tag;
   index_of_tag.reserve(node_tags.size());
+  MeshTags tags;
+  tags.node.resize(node_tags.size());
   Eigen::Matrix3Xd X(3, static_cast<Eigen::Index>(node_tags.size()));
   for (std::size_t i = 0; i < by_tag.size(); ++i) {
     const std::size_t k = by_tag[i];
     index_of_tag.emplace(node_tags[k], static_cast<int>(i));
+    tags.node[i] = node_tags[k];
     X.col(static_cast<Eigen::Index>(i)) << coords[3 * k], coords[3 * k + 1], coords[3 * k + 2];
   }
   std::vector<Eigen::Vector4i> tets(elem_tags.size());
   for (std::size_t e = 0; e < elem_tags.size(); ++e) {
     for (int k = 0; k < 4; ++k) {
       const auto it = index_of_tag.find(elem_nodes[4 * e + k]);
-      if (it == index_of_tag.end()) fail(path, "a tetrahedron refers to an undefined node");
+      if (it == index_of_tag.end())
+        fail(path, "tetrahedron " + std::to_string(elem_tags[e]) +
+                       " (element tag in the file) refers to an undefined node " +
+                       std::to_string(elem_nodes[4 * e + k]));
       tets[e][k] = it->second;
     }
   }
-  return make_mesh(std::move(X), std::move(tets), path);
+  tags.tet = std::move(elem_tags);
+  return make_mesh(std::move(X), std::move(tets), path, tags);
 }
 
 std::vector<std::vector<int>> node_adjacency(const TetMesh& mesh) {

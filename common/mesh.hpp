@@ -30,9 +30,15 @@ struct MeshError : std::runtime_error {
 // degenerate. Inverted tetrahedra are reoriented and counted; unused nodes dropped.
 TetMesh load_mesh(const std::string& path);
 
+// The file's own numbers of the nodes (in X's column order) and of the tetrahedra, so that an
+// error names them as the file and gmsh's GUI do; empty for a mesh made in memory.
+struct MeshTags {
+  std::vector<std::size_t> node, tet;
+};
+
 // Builds a mesh from arrays (tests and generated scenes), with the same validation.
 TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets,
-                  const std::string& name = "<memory>");
+                  const std::string& name = "<memory>", const MeshTags& tags = {});
 
 // Node pairs (i, j) sharing a tetrahedron, i and j included: the sparsity of the system.
 std::vector<std::vector<int>> node_adjacency(const TetMesh& mesh);

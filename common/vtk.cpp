@@ -1,5 +1,6 @@
 #include "common/vtk.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -21,7 +22,41 @@ std::ofstream open_or_throw(const std::filesystem::path& path) {
   return out;
 }
 
+// name_NNNNNN.vtu: a frame of the series `name` (not of another series in the same folder).
+bool is_frame_of(const std::string& file, const std::string& name) {
+  const std::size_t digits = 6, size = name.size() + 1 + digits + 4;
+  if (file.size() != size || file.compare(0, name.size() + 1, name + "_") != 0 ||
+      file.compare(size - 4, 4, ".vtu") != 0)
+    return false;
+  return std::all_of(file.begin() + static_cast<long>(name.size()) + 1, file.end() - 4,
+                     [](char c) { return c >= '0' && c <= '9'; });
+}
+
 }  // namespace
+
+void VtkSeries::check_writable(const std::string& directory) {
+  // Permission bits do not tell (root passes them on a read-only /proc): try for real, and
+  // undo what the try made.
+  namespace fs = std::filesystem;
+  std::error_code error;
+  fs::path existing = fs::absolute(directory, error);
+  while (!existing.empty() && !fs::exists(existing, error) && existing != existing.parent_path())
+    existing = existing.parent_path();
+  const fs::path probe = fs::path(directory) / ".fem_write_probe";
+  const bool made = fs::create_directories(directory, error);
+  bool writable = !error && fs::is_directory(directory, error);
+  if (writable) {
+    writable = static_cast<bool>(std::ofstream(probe));
+    fs::remove(probe, error);
+  }
+  if (made) {
+    for (fs::path p = fs::absolute(directory, error); p != existing && p != p.parent_path();
+         p = p.parent_path())
+      fs::remove(p, error);
+  }
+  if (!writable)
+    throw std::runtime_error("cannot create or write the output directory '" + directory + "'");
+}
 
 VtkSeries::VtkSeries(std::string directory, std::string name)
     : directory_(std::move(directory)), name_(std::move(name)) {
@@ -30,6 +65,10 @@ VtkSeries::VtkSeries(std::string directory, std::string name)
   if (error || !std::filesystem::is_directory(directory_))
     throw std::runtime_error("cannot create the output directory '" + directory_ +
                              "': " + error.message());
+  for (const auto& entry : std::filesystem::directory_iterator(directory_))
+    if (is_frame_of(entry.path().filename().string(), name_) &&
+        std::filesystem::remove(entry.path(), error))
+      ++replaced_frames_;
 }
 
 std::string VtkSeries::pvd_path() const {

@@ -77,6 +77,18 @@ TEST_CASE("a degenerate tetrahedron is reported", "[mesh]") {
   CHECK_THROWS_WITH(load_mesh(path), contains_text("degenerate"));
 }
 
+TEST_CASE("an error names nodes and tetrahedra by the file's tags, not by position", "[mesh]") {
+  // Element tags 1 (a triangle), 2 (a good tetrahedron), 3 (a flat one: the second
+  // tetrahedron, index 1); node tags from 1, so the third node is node 3 (index 2).
+  const auto flat = write_msh("flat_tagged", {"0 0 0", "1 0 0", "0 1 0", "0 0 1", "1 1 0"},
+                              {{2, "1 2 3"}, {4, "1 2 3 4"}, {4, "1 2 3 5"}});
+  CHECK_THROWS_WITH(load_mesh(flat), contains_text("tetrahedron 3 (element tag in the file)"));
+  auto nodes = kUnitTet;
+  nodes[2] = "0 nan 0";
+  CHECK_THROWS_WITH(load_mesh(write_msh("nan_tagged", nodes, {{4, "1 2 3 4"}})),
+                    contains_text("node 3 (tag in the file)"));
+}
+
 TEST_CASE("NaN or infinite coordinates are reported", "[mesh]") {
   auto nodes = kUnitTet;
   nodes[2] = "0 nan 0";
