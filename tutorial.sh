@@ -266,7 +266,7 @@ variant() {
 }
 
 diff_variant() {
-  [ $# -eq 1 ] || { echo "usage: ./tutorial.sh diff VARIANT (e.g. 06_my_fused_updates)" >&2; exit 2; }
+  [ $# -eq 1 ] || { echo "usage: ./tutorial.sh diff VARIANT (its name, e.g. my_fused_updates, or its folder 06_my_fused_updates)" >&2; exit 2; }
   python3 scripts/chapter_diffs.py --variant "$1"
 }
 

@@ -127,7 +127,14 @@ int run_lesson(const Found& found, int argc, char** argv) {
     if ((!readme.empty() || !json.empty()) && runs.size() > 1)
       throw UsageError("--readme and --json record the course's table: leave --chapter out");
     if (!json.empty()) check_writable(json);
+    // A lesson may leave std::fixed and a precision on the streams: the next run (a
+    // variant's, after the original's) starts from the streams' defaults again.
+    std::ios cout_defaults(nullptr), cerr_defaults(nullptr);
+    cout_defaults.copyfmt(std::cout);
+    cerr_defaults.copyfmt(std::cerr);
     for (const auto& [chapter, lesson] : runs) {
+      std::cout.copyfmt(cout_defaults);
+      std::cerr.copyfmt(cerr_defaults);
       if (runs.size() > 1) std::cout << "\n### " << chapter->id << "\n\n";
       const std::string table = measure(lesson, {args, scene, steps, chapter->id});
       std::cout << table << std::flush;

@@ -116,21 +116,34 @@ def variant_diff(root, variant):
     change is one hunk."""
     sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
     import make_variant
-    current = root / "chapters" / variant
-    if not (current / "variant_of").exists():
-        raise SystemExit(f"chapter_diffs.py: chapters/{variant} is not a variant (no variant_of file)")
+    current = find_variant(root, variant)
+    variant = current.name
     original = root / "chapters" / (current / "variant_of").read_text().strip()
+    number = original.name[:2]
     out = []
     for path in sorted(p for p in current.iterdir() if p.is_file() and p.name != "variant_of"):
         a = original / path.name
         old = a.read_text() if a.exists() else ""
         if path.name == "README.md" and old:
             old = make_variant.readme_heading(old, original.name, variant)
-        old = make_variant.rewrite(old, original.name, variant, original.name[:2])
-        out += difflib.unified_diff(old.splitlines(keepends=True),
-                                    path.read_text().splitlines(keepends=True),
+        # Both sides in the original's names: the context reads as the original's code.
+        new = make_variant.unrewrite(path.read_text(), original.name, variant, number)
+        out += difflib.unified_diff(old.splitlines(keepends=True), new.splitlines(keepends=True),
                                     fromfile=str(a.relative_to(root)), tofile=str(path.relative_to(root)))
     return "".join(out)
+
+
+def find_variant(root, name):
+    """A variant by its folder (10_mine) or by its name alone (mine), as chapters/README.md
+    says a variant answers to its name; refused when no variant or several have it."""
+    chapters = root / "chapters"
+    found = [chapters / name] if (chapters / name / "variant_of").exists() else sorted(
+        d for d in chapters.glob(f"[0-9][0-9]_{name}") if (d / "variant_of").exists())
+    if len(found) != 1:
+        known = ", ".join(sorted(d.parent.name for d in chapters.glob("*/variant_of"))) or "none"
+        what = "no variant" if not found else "several variants"
+        raise SystemExit(f"chapter_diffs.py: {what} named '{name}' (variants: {known})")
+    return found[0]
 
 
 INCLUDE = re.compile(r'#include "chapters/(\d\d_\w+)/([\w.]+)"')

@@ -40,6 +40,13 @@ def rewrite(text, original, variant, number):
     return re.sub(rf"\bch{number}\b", f"ch{number}_{variant[3:]}", text)
 
 
+def unrewrite(text, original, variant, number):
+    """The inverse of rewrite: the variant's text in the original's names, so that a diff's
+    context lines read as the original's code and only the student's change stands out."""
+    text = text.replace(f"chapters/{variant}/", f"chapters/{original}/")
+    return re.sub(rf"\bch{number}_{re.escape(variant[3:])}\b", f"ch{number}", text)
+
+
 def readme_heading(text, original, variant):
     lines = text.splitlines(keepends=True)
     title = re.sub(r"^# Chapter [^:]+:\s*", "", lines[0]).strip() if lines else original
@@ -85,12 +92,14 @@ def main():
     except VariantError as e:
         print(f"make_variant.py: {e}", file=sys.stderr)
         return 2
+    sources = sorted(p.name for p in (args.root / "chapters" / variant).iterdir()
+                     if p.suffix in (".cpp", ".hpp"))
     print(f"""made chapters/{variant}/, a copy of chapters/{original}/ (namespace fem::ch{variant})
 next:
-  edit chapters/{variant}/stepper.cpp
-  ./tutorial.sh test -R {variant}                   # the checks every chapter passes
-  ./tutorial.sh bench --chapters {original[:2]},{variant} --out results/{args.name}
-  ./tutorial.sh diff {variant}                   # your change, the copy's renames undone""")
+  edit the file(s) your change is in: {", ".join(sources)}
+  ./tutorial.sh test -L ch{variant}                   # the checks every chapter passes
+  ./tutorial.sh bench --chapters {original[:2]},{variant} --no-solvers --out results/{args.name}
+  ./tutorial.sh diff {args.name}                   # your change, the copy's renames undone""")
     return 0
 
 

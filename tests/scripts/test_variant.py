@@ -51,6 +51,10 @@ def main():
 
         p = run(*make, "06", "my_fused_updates")
         check("make_variant.py 06 my_fused_updates exits 0", p.returncode == 0, p.stderr)
+        check("its next steps name the copy's sources, the variant's own test label and the "
+              "diff by name", "stepper.cpp, stepper.hpp" in p.stdout
+              and "test -L ch06_my_fused_updates" in p.stdout and "--no-solvers" in p.stdout
+              and "diff my_fused_updates" in p.stdout and "edit chapters/" not in p.stdout, p.stdout)
         variant = repo / "chapters" / "06_my_fused_updates"
         check("the copy has the original's files",
               sorted(f.name for f in (repo / "chapters" / "06_custom_pcg").iterdir()) + ["variant_of"]
@@ -77,6 +81,16 @@ def main():
         check("a one-line change is one hunk of one line", p.returncode == 0
               and p.stdout.count("\n@@") + p.stdout.startswith("@@") == 1
               and p.stdout.count("\n+namespace {  // changed") == 1, p.stdout[:2000] + p.stderr)
+        check("its context reads in the original's names, not the copy's",
+              "ch06_my_fused_updates" not in p.stdout and "06_my_fused_updates/" not in
+              p.stdout.split("\n@@")[-1], p.stdout[:2000])
+        by_name = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo,
+                      "--variant", "my_fused_updates")
+        check("a variant answers to its name alone", by_name.stdout == p.stdout, by_name.stderr)
+        nothing = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo,
+                      "--variant", "no_such_variant")
+        check("an unknown variant is refused with the known ones", nothing.returncode != 0
+              and "06_my_fused_updates" in nothing.stderr, nothing.stderr)
         (variant / "stepper.cpp").write_text(cpp)
 
         # Refusals, with the reason.
