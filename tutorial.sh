@@ -184,7 +184,7 @@ build() {
 # place, otherwise a line at every tenth of the build, so that a first build (minutes) is never
 # silent. Every line goes on to the log.
 build_progress() {
-  local build_log="$1" tty=0 line count total last=-1
+  local build_log="$1" tty=0 line count total last=-1 said=$SECONDS
   [ -t 1 ] && tty=1
   while IFS= read -r line; do
     printf '%s\n' "$line" >>"$build_log"
@@ -192,8 +192,9 @@ build_progress() {
     count=${BASH_REMATCH[1]} total=${BASH_REMATCH[2]}
     if [ "$tty" -eq 1 ]; then
       printf '\r\033[K  [%s/%s] %.100s' "$count" "$total" "${line#*] }"
-    elif [ $((count * 10 / total)) -ne "$last" ] || [ "$count" -eq "$total" ]; then
-      last=$((count * 10 / total))
+    elif [ $((count * 10 / total)) -ne "$last" ] || [ "$count" -eq "$total" ] ||
+      [ $((SECONDS - said)) -ge 30 ]; then
+      last=$((count * 10 / total)) said=$SECONDS
       printf '  [%s/%s] %s\n' "$count" "$total" "${line#*] }"
     fi
   done
@@ -221,7 +222,29 @@ quiet_build() {
 run_tests() {
   build
   log "running the tests"
-  ctest --preset "$PRESET" -j "$(nproc)" "$@"
+  ctest --preset "$PRESET" -j "$(nproc)" "$@" 2>&1 | with_heartbeat
+  return "${PIPESTATUS[0]}"
+}
+
+# Passes its input on, and when it has been silent for 30 s says so with the time since the
+# start: ctest prints a test only when it ends, and the coursework tests (labels variants and
+# exercises) build copies of the repository for minutes.
+with_heartbeat() {
+  local line start=$SECONDS done=0 status
+  while :; do
+    IFS= read -r -t 30 line
+    status=$?
+    if [ "$status" -eq 0 ]; then
+      printf '%s\n' "$line"
+      [[ "$line" =~ Test\ +#[0-9]+: ]] && done=$((done + 1))
+    elif [ "$status" -gt 128 ]; then
+      printf '  ... %d s, %d tests finished; still running (the coursework tests build copies of the repository)\n' \
+        $((SECONDS - start)) "$done"
+    else
+      [ -n "$line" ] && printf '%s\n' "$line"
+      break
+    fi
+  done
 }
 
 # A run is a folder: fem_bench writes DIR/bench.json and the plots are made from that file,
