@@ -43,6 +43,10 @@ commands:
              --mesh, --scene, --steps; fem_bench --help)
   diff       a variant's change against its original, the copy's renames undone (the hand-in):
              ./tutorial.sh diff 06_my_fused_updates
+  handin-check
+             a teacher's check of a hand-in: ./tutorial.sh handin-check handin/06_fused (the
+             variant's sources against the run's record, its diff, its tests, the plots
+             regenerated from the JSON; docs/coursework.md)
   plots      remake the plots of a run folder from its bench.json: ./tutorial.sh plots DIR
   variant    copy a chapter under a new name to change it and measure it against the
              original: ./tutorial.sh variant 06 my_fused_updates (chapters/README.md)
@@ -288,6 +292,14 @@ variant() {
   "$VENV/bin/python" scripts/make_variant.py "$@"
 }
 
+# A teacher's check of a hand-in (scripts/check_handin.py --help): the variant's sources against
+# the run's record, its diff, its tests, the plots regenerated from the JSON.
+handin_check() {
+  [ $# -ge 1 ] || { echo "usage: ./tutorial.sh handin-check FOLDER [--variant NN_NAME] (a run's folder handed in)" >&2; exit 2; }
+  build
+  "$VENV/bin/python" scripts/check_handin.py --build "$BUILD_DIR" "$@"
+}
+
 diff_variant() {
   [ $# -eq 1 ] || { echo "usage: ./tutorial.sh diff VARIANT (its name, e.g. my_fused_updates, or its folder 06_my_fused_updates)" >&2; exit 2; }
   python3 scripts/chapter_diffs.py --variant "$1"
@@ -418,6 +430,7 @@ main() {
     plots) plots "$@" ;;
     variant) variant "$@" ;;
     diff) diff_variant "$@" ;;
+    handin-check) handin_check "$@" ;;
     scaling) scaling "$@" ;;
     regimes) regimes "$@" ;;
     threads) threads "$@" ;;

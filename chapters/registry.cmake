@@ -22,6 +22,11 @@ if(NOT CMAKE_SCRIPT_MODE_FILE)
       list(APPEND FEM_CHAPTER_INPUTS ${dir}/variant_of)
     endif()
   endforeach()
+  # Every source of a chapter is an input: the registry records a hash of each chapter's
+  # sources (a run's JSON names the code it measured), so an edit regenerates it.
+  file(GLOB FEM_CHAPTER_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/chapters/*/*.cpp
+       ${CMAKE_CURRENT_SOURCE_DIR}/chapters/*/*.hpp)
+  list(APPEND FEM_CHAPTER_INPUTS ${FEM_CHAPTER_SOURCES})
   # A variant_of file added later is seen: the glob reruns the configuration.
   file(GLOB FEM_CHAPTER_VARIANT_FILES CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/chapters/*/variant_of)
   set(FEM_CHAPTER_REGISTRY ${CMAKE_CURRENT_BINARY_DIR}/generated/chapter_list.cpp)
@@ -45,6 +50,21 @@ endif()
 
 function(fem_fail dir message)
   message(FATAL_ERROR "chapters/${dir}: ${message} (the convention: chapters/README.md)")
+endfunction()
+
+# The hash of a chapter's sources, as scripts/check_handin.py computes it: SHA-256 of the
+# lines "<file> <SHA-256 of the file>\n" of its .cpp and .hpp files, sorted by name.
+function(fem_source_hash out dir)
+  file(GLOB sources RELATIVE ${SOURCE_DIR}/chapters/${dir} ${SOURCE_DIR}/chapters/${dir}/*.cpp
+       ${SOURCE_DIR}/chapters/${dir}/*.hpp)
+  list(SORT sources)
+  set(manifest "")
+  foreach(source ${sources})
+    file(SHA256 ${SOURCE_DIR}/chapters/${dir}/${source} hash)
+    string(APPEND manifest "${source} ${hash}\n")
+  endforeach()
+  string(SHA256 hash "${manifest}")
+  set(${out} ${hash} PARENT_SCOPE)
 endfunction()
 
 # C++ string literal of a text.
@@ -96,7 +116,9 @@ foreach(header ${headers})
     string(APPEND includes "#include \"chapters/${dir}/lesson.hpp\"\n")
     set(lessons "&fem::${ns}::lessons")
   endif()
-  string(APPEND entries "      chapter<fem::${ns}::${class}>(\"${dir}\", ${title_literal}, \"${variant_of}\", ${lessons}),\n")
+  fem_source_hash(source_hash ${dir})
+  string(APPEND entries "      chapter<fem::${ns}::${class}>(\"${dir}\", ${title_literal}, \"${variant_of}\", ${lessons},\n"
+                        "                                    \"${source_hash}\"),\n")
 endforeach()
 if(entries STREQUAL "")
   message(FATAL_ERROR "no chapters/*/stepper.hpp found")
@@ -115,12 +137,12 @@ namespace {
 
 template <class ChapterStepper>
 ChapterInfo chapter(std::string id, std::string title, std::string variant_of,
-                    std::vector<Lesson> (*lessons)()) {
+                    std::vector<Lesson> (*lessons)(), std::string source_hash) {
   return {std::move(id), std::move(title),
           [](const Scene& scene, const SolverSettings& s) {
             return std::unique_ptr<Stepper>(std::make_unique<ChapterStepper>(scene, s));
           },
-          std::move(variant_of), lessons};
+          std::move(variant_of), lessons, std::move(source_hash)};
 }
 
 }  // namespace

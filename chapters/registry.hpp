@@ -20,6 +20,9 @@ struct ChapterInfo {
   std::string variant_of;  // a student's variant: the chapter it was copied from; else ""
   // The measurements behind the chapter's lesson tables (its lesson.hpp), or nullptr.
   std::vector<Lesson> (*lessons)() = nullptr;
+  // SHA-256 of the chapter folder's sources when the program was built (chapters/registry.cmake
+  // says how): a run's JSON records it, so a hand-in's run is tied to the code handed in.
+  std::string source_hash;
 };
 
 // Every chapter present, in order; each variant right after the chapter it came from. The
