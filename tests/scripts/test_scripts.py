@@ -113,6 +113,21 @@ def main():
               str([(c["chapter"], r["chapter"]) for c, r in pairs]))
         check("each variant row's speedup over its original is the measured one (x2)",
               all(r["median_ms"]["step"] / c["median_ms"]["step"] == 2.0 for c, r in pairs))
+        # The variant's run drawn: the plots' layout checks (no legend over a bar, no tick labels
+        # into each other) pass on it, and they do catch a legend laid over the bars.
+        (out / "variant").mkdir()
+        (out / "variant" / "bench.json").write_text(json.dumps(variant_run))
+        p = run(SCRIPTS / "plot_results.py", out / "variant" / "bench.json", "--out", out / "variant")
+        check("a variant's run draws readable plots (the layout checks pass)", p.returncode == 0,
+              p.stdout + p.stderr)
+        import matplotlib.pyplot as plt  # noqa: E402
+        fig, ax = plt.subplots()
+        ax.bar([0, 1, 2], [3, 3, 3], label="bars")
+        ax.legend(loc="center")
+        fig.canvas.draw()
+        check("the layout check finds a legend that covers bars",
+              any("legend" in problem for problem in plot_results.layout_problems(fig)))
+        plt.close(fig)
         two = copy.deepcopy(bench)
         two["chapters"] = [c for c in bench["chapters"] if c["chapter"] != "01_naive"][:2]
         pairs, ylabel, _ = plot_results.speedup_references(two)
