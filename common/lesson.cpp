@@ -1,18 +1,11 @@
 #include "common/lesson.hpp"
 
-#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
 #include "common/build_info.hpp"
 
 namespace fem {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
 
 void progress(const std::string& what) {
   std::cerr << "  fem_lessons: " << what << "\n" << std::flush;

@@ -11,6 +11,7 @@
 
 #include "common/cli.hpp"
 #include "common/scene.hpp"
+#include "common/statistics.hpp"
 
 namespace fem {
 
@@ -37,8 +38,6 @@ struct Lesson {
 };
 
 // ---- what the measurements share ----------------------------------------------------------
-
-double median(std::vector<double> v);
 
 // Median wall-clock milliseconds (std::chrono::steady_clock) of f, run `repeat` times but
 // stopped once `budget_s` seconds are spent (after one run at least), so that a lesson on a

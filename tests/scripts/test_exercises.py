@@ -137,7 +137,7 @@ EXERCISES = [
      "expect": "measured",
      "lesson": "build/release/fem_lessons half-the-bytes --chapter 12_NAME"},
     {"id": "12/4", "chapter": "12", "name": "ex_lanes",
-     "change": [("element_batch.hpp", "constexpr int kLanes = 8;", "constexpr int kLanes = 4;")],
+     "change": [("batch_rotations.hpp", "constexpr int kLanes = 8;", "constexpr int kLanes = 4;")],
      "bench": "build/release/fem_bench --chapters 12,12_NAME --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons batched-elements --chapter 12_NAME"},

@@ -261,6 +261,33 @@ def main():
         check("check_chapter_sources.py accepts a chapter that names only itself",
               p.returncode == 0, p.stdout + p.stderr)
 
+        # The size limits: a long function, a long file and a wide struct are caught, and the
+        # same code within the limits (a brace in a string, an initializer, a long stepper of
+        # an early chapter) is not.
+        sizes = tmp / "sizes"
+        for folder in ("chapters/09_wide", "chapters/03_early", "common", "apps"):
+            (sizes / folder).mkdir(parents=True)
+        body = "".join(f"  x += {k};\n" for k in range(59))
+        (sizes / "common" / "long.cpp").write_text(
+            'int f(int x) {\n  const char* s = "}";\n' + body + "}\n"
+            "Foo::Foo() : a_{1}, b_(2) {\n" + body[:-11] + "}\n")
+        members = "".join(f"  double m{k} = {{}};\n" for k in range(17))
+        (sizes / "chapters" / "09_wide" / "wide.hpp").write_text(
+            "struct Wide {\n  using T = int;\n  static constexpr int k = 1;\n  int f() const;\n"
+            + members + "  struct Inner {\n    int a, b;\n  } inner, other;\n};\n")
+        (sizes / "chapters" / "03_early" / "stepper.hpp").write_text(
+            "struct Early {\n" + members + "  int more, still_more;\n};\n" + "\n" * 400)
+        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
+        check("check_sizes.py catches a long function, a long chapter file and a wide struct",
+              p.returncode == 1 and "f is 62 lines" in p.stderr and "Foo::Foo" not in p.stderr
+              and "Wide has 19 data members" in p.stderr and "Inner" not in p.stderr
+              and "stepper.hpp: 420 lines" in p.stderr and "Early has" not in p.stderr, p.stderr)
+        (sizes / "common" / "long.cpp").write_text("int f(int x) {\n" + body[:-11] + "}\n")
+        (sizes / "chapters" / "09_wide" / "wide.hpp").write_text("struct Wide {\n" + members + "};\n")
+        (sizes / "chapters" / "03_early" / "stepper.hpp").write_text("struct Early {};\n")
+        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
+        check("check_sizes.py accepts code within the limits", p.returncode == 0, p.stdout + p.stderr)
+
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0
 
