@@ -78,15 +78,6 @@ std::array<PairOf, 16> pair_of_blocks() {
 }
 const std::array<PairOf, 16> kPairOf = pair_of_blocks();
 
-// total += mine, from every thread once. An integer sum is exact in any order, so the one
-// atomic of the chapter leaves the result independent of the threads. (Not an OpenMP
-// reduction: on an orphaned loop of a variable a lambda captures, Clang 14 refuses it,
-// "reduction variable must be shared", where GCC accepts it.)
-void add_count(long long& total, long long mine) {
-#pragma omp atomic
-  total += mine;
-}
-
 }  // namespace
 
 ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& settings,

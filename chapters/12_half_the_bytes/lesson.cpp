@@ -9,6 +9,7 @@
 #include <string>
 
 #include "chapters/08_element_kernels/element_kernels.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/11_node_order/node_order.hpp"
 #include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/element_batch.hpp"
@@ -33,8 +34,8 @@ double double_megabytes(const ch10::Multigrid& mg) {
   long long bytes = 0;
   for (int l = 0; l + 1 < mg.levels(); ++l) {
     const long long b = l == 0 ? 3 : ch10::kModes;
-    bytes += 8 * b * b * (mg.level_blocks(l) + mg.level_dofs(l) / b);
-    bytes += 2 * 8 * b * ch10::kModes * mg.prolongator_blocks(l);
+    bytes += 8 * b * b * (ch10::level_blocks(mg, l) + ch10::level_dofs(mg, l) / b);
+    bytes += 2 * 8 * b * ch10::kModes * ch10::prolongator_blocks(mg, l);
   }
   return 1e-6 * static_cast<double>(bytes);
 }
