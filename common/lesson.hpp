@@ -58,6 +58,11 @@ std::string mesh_name(const Scene& scene);
 // "AMD EPYC ..., GNU 12.2.0, `-O3 ...`": where and how a table was measured.
 std::string measured_on();
 
+// The run's scene (its name, material, time step and damping) on each mesh of the lesson's
+// comma-separated --meshes option: a table for each. All are loaded before any is measured,
+// so that a bad path fails at once.
+std::vector<Scene> more_meshes(const LessonRun& run);
+
 // ---- definitions of the templates -----------------------------------------------------
 
 template <class F>

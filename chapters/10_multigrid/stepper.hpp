@@ -35,7 +35,7 @@ class VCyclePreconditioner final : public ch09::Preconditioner {
   Multigrid& multigrid_;
 };
 
-// Not final: chapter 11 runs this step on a renumbered mesh.
+// Not final: a derived stepper may run this step on other data (a renumbered mesh).
 class MultigridStepper : public ch09::ThreadsStepper {
  public:
   MultigridStepper(

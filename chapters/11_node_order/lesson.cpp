@@ -112,14 +112,7 @@ std::string one_mesh_table(const LessonRun& run) {
 
 // The scene's mesh, then each of --meshes (the same scene and material on it): one table each.
 std::string node_order_table(const LessonRun& run) {
-  std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
-  std::stringstream list(run.args.get("meshes"));
-  for (std::string path; std::getline(list, path, ',');) {
-    if (path.empty()) continue;
-    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
-    scenes.back().dt = run.scene.dt;
-    scenes.back().damping = run.scene.damping;
-  }
+  const std::vector<Scene> scenes = more_meshes(run);
   std::string tables = one_mesh_table(run);
   for (const Scene& scene : scenes)
     tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});
