@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -18,6 +19,12 @@ double median(std::vector<double> v) {
 
 void progress(const std::string& what) {
   std::cerr << "  fem_lessons: " << what << "\n" << std::flush;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
 }
 
 std::string code(const std::string& s) {

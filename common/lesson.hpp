@@ -49,6 +49,9 @@ double time_ms(int repeat, F&& f, double budget_s = 10.0);
 // Progress of a long lesson, on stderr so that stdout stays the Markdown table.
 void progress(const std::string& what);
 
+// v with `digits` digits after the point, for a table cell.
+std::string fixed(double v, int digits);
+
 // `s` as Markdown code, with '|' replaced so that a table cell stays intact.
 std::string code(const std::string& s);
 

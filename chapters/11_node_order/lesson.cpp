@@ -49,12 +49,6 @@ std::vector<Run> runs_for(const LessonRun& run) {
   return runs;
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
-
 // One row: the order's measures of memory distance, and its times (1 thread, medians).
 std::string row(Run& r) {
   const OrderQuality q = order_quality(renumbered(r.scene, r.stepper->order(), false).mesh);

@@ -23,12 +23,6 @@ namespace fem::ch12 {
 
 namespace {
 
-std::string fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
-
 // Chapter 10's hierarchy in double: every level's blocks and inverse diagonals, P and P^T
 // (the coarsest level is a dense Cholesky factor, the same in both chapters: not counted).
 double double_megabytes(const ch10::Multigrid& mg) {
