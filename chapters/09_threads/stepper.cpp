@@ -78,16 +78,6 @@ std::array<PairOf, 16> pair_of_blocks() {
 }
 const std::array<PairOf, 16> kPairOf = pair_of_blocks();
 
-// total += mine, from every thread once. An integer sum is exact in any order, so the one
-// atomic of the chapter leaves the result independent of the threads. (Not an OpenMP
-// reduction: OpenMP requires a reduction variable of an orphaned loop to be shared in the
-// enclosing region, which a variable a lambda captures is not visibly, and Clang holds to
-// it: "reduction variable must be shared".)
-void add_count(long long& total, long long mine) {
-#pragma omp atomic
-  total += mine;
-}
-
 }  // namespace
 
 ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& settings,

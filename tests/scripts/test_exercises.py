@@ -110,7 +110,7 @@ EXERCISES = [
      "test": "./tutorial.sh test -L ch09_NAME", "test_passes": False,
      "failing": "the same state to the last bit on 1, 2 and 3 threads"},
     {"id": "10/4", "chapter": "10", "name": "ex_yardstick",
-     "change": [("multigrid.cpp",
+     "change": [("refresh_rule.cpp",
                  "    measure_next_ = false;\n  }\n",
                  "    measure_next_ = false;\n  } else if (!measure_next_) {\n"
                  "    cycles_after_refresh_ = std::min(cycles_after_refresh_, last);\n  }\n")],
