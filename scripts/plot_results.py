@@ -167,7 +167,8 @@ def plot_phases_stacked(data, out):
     ax.set_xlim(0, 1.15 * max(r[2] for r in rows))
     ax.set_xlabel(f"median time per step [ms]; at the end: the step and its speedup over {rows[0][0]}")
     ax.set_title(f"The course at a glance: the step split into its phases ({run_label(data)})")
-    ax.legend(fontsize=8, loc="lower right", title="phase (median per step)", title_fontsize=8)
+    # Beside the axes: inside them, a run with few rows (a variant's) has no free corner.
+    legend_outside(ax, "phase (median per step)")
     ax.grid(axis="x", alpha=0.3)
     finish(fig, data, out / "phases_stacked.png")
 

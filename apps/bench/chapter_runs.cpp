@@ -41,6 +41,7 @@ std::vector<ChapterRun> make_runs(const std::vector<const ChapterInfo*>& chapter
       run.result.chapter = threaded ? c->id + "@" + std::to_string(threads) : c->id;
       run.result.title = c->title;
       run.result.variant_of = c->variant_of;
+      run.result.source_hash = c->source_hash;
       run.result.threads = threads;
       runs.push_back(std::move(run));
     }

@@ -19,6 +19,7 @@ struct ChapterResult {
   std::string chapter;  // "09_threads@2": a chapter that uses threads, with its thread count
   std::string title;
   std::string variant_of;                        // a student's variant: its original
+  std::string source_hash;                       // the chapter folder's sources, at build time
   std::array<Spread, 6> ms{};                    // per phase, milliseconds
   double allocations_per_step = 0.0;             // median over the measured steps
   std::array<long long, 6> phase_allocations{};  // per phase, the last measured step

@@ -31,8 +31,9 @@ std::vector<SolverResult> solve_tables(const Scene& scene, const BenchOptions& o
 
 int run_bench(const ArgParser& args) {
   const BenchOptions options = bench_options(args);
-  if (!options.json.empty()) check_writable(options.json);
+  // The scene before the folder: a bad mesh or material leaves no empty run folder behind.
   const Scene scene = scene_from_args(args);
+  if (!options.json.empty()) check_writable(options.json);
   const SourceState source = source_state();
   print_setup(scene, options, source);
   LoadMonitor load;
@@ -48,8 +49,10 @@ int run_bench(const ArgParser& args) {
     const bool replaced = std::filesystem::exists(path);
     const int removed = options.json_named ? 0 : remove_previous_plots(path);
     write_json(path, scene, options, results, solvers, load, source);
-    std::cout << "\nwrote " << path << (replaced ? " (replacing the run that was there" : "")
+    std::cout << "\nwrote " << path
+              << (replaced ? " (--replace: replacing the run that was there" : "")
               << (replaced && removed ? ", and its plots" : "") << (replaced ? ")" : "") << "\n";
+    if (!options.latest.empty()) point_latest_at(options.latest);
   }
   if (const std::string warning = load.warning(); !warning.empty()) std::cerr << warning << "\n";
   return 0;

@@ -1,6 +1,7 @@
 #include "apps/bench/options.hpp"
 
 #include <algorithm>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -48,14 +49,31 @@ std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
   std::stringstream in(list);
   std::string name;
   while (std::getline(in, name, ',')) {
+    const ChapterInfo* found = nullptr;
     try {
-      out.push_back(&find_chapter(name));
+      found = &find_chapter(name);
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }
+    // Twice the same chapter would be two rows of one name in every table and plot.
+    if (std::find(out.begin(), out.end(), found) != out.end())
+      throw UsageError("--chapters names " + found->id + " twice");
+    out.push_back(found);
   }
   if (out.empty()) throw UsageError("--chapters is empty");
   return out;
+}
+
+// Without --out, a new folder per run, results/run-YYYYMMDD-HHMMSS (a second run in the same
+// second gets -2, -3, ...): a run never replaces an earlier one unless asked (--replace).
+std::string new_run_folder() {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "run-%Y%m%d-%H%M%S", std::localtime(&now));
+  std::string folder = std::string("results/") + stamp;
+  for (int k = 2; std::filesystem::exists(folder); ++k)
+    folder = std::string("results/") + stamp + "-" + std::to_string(k);
+  return folder;
 }
 
 // --json FILE, else DIR/bench.json of --out DIR; "" with --no-json or when both are empty.
@@ -66,8 +84,8 @@ std::string json_path(const ArgParser& args) {
     return "";
   }
   if (!args.get("json").empty()) return args.get("json");
-  if (args.get("out").empty()) return "";
-  return (std::filesystem::path(args.get("out")) / "bench.json").string();
+  const std::string out = args.get("out").empty() ? new_run_folder() : args.get("out");
+  return (std::filesystem::path(out) / "bench.json").string();
 }
 
 Schedule schedule(const ArgParser& args) {
@@ -92,8 +110,11 @@ void add_bench_options(ArgParser& args) {
               "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)",
               "10");
   args.option("out", "DIR",
-              "the run's folder: writes DIR/bench.json and removes the last run's plots there",
-              "results");
+              "the run's folder: writes DIR/bench.json (default: a new folder "
+              "results/run-DATE-TIME, and results/latest points to it); a folder that holds a "
+              "run is refused unless --replace",
+              "");
+  args.flag("replace", "replace the run (bench.json and its plots) in --out DIR or at --json FILE");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
   args.flag("no-json", "write no JSON (print the tables only)");
   args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
@@ -112,6 +133,13 @@ BenchOptions bench_options(const ArgParser& args) {
   o.thread_counts = parse_thread_counts(args.get("threads"));
   o.json = json_path(args);
   o.json_named = !args.get("json").empty();
+  o.replace = args.has_flag("replace");
+  if (!o.json.empty() && !o.json_named && args.get("out").empty())
+    o.latest = std::filesystem::path(o.json).parent_path().filename().string();
+  if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))
+    throw UsageError("'" + o.json +
+                     "' holds an earlier run: give another --out (or --json), or --replace to "
+                     "replace it and its plots");
   o.solve_tables = !args.has_flag("no-solvers");
   return o;
 }

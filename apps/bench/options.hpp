@@ -18,6 +18,8 @@ struct BenchOptions {
   SolverSettings solver;
   std::string json;         // where the JSON goes; "" for none
   bool json_named = false;  // --json FILE: outside a run folder, whose plots stay
+  bool replace = false;     // --replace: an earlier run at the same place may be replaced
+  std::string latest;       // the run's folder is a new one under results/: point latest at it
   bool solve_tables = true;
 };
 

@@ -56,7 +56,8 @@ void write_run(std::ostream& out, const Scene& scene, const BenchOptions& option
 
 void write_chapter(std::ostream& out, const ChapterResult& r) {
   out << "    {\"chapter\": " << json_string(r.chapter) << ", \"title\": " << json_string(r.title)
-      << (r.variant_of.empty() ? "" : ", \"variant_of\": " + json_string(r.variant_of)) << ",\n"
+      << (r.variant_of.empty() ? "" : ", \"variant_of\": " + json_string(r.variant_of))
+      << ", \"source_hash\": " << json_string(r.source_hash) << ",\n"
       << "     \"median_ms\": " << spread_json(r.ms, &Spread::median) << ",\n"
       << "     \"min_ms\": " << spread_json(r.ms, &Spread::min) << ",\n"
       << "     \"q1_ms\": " << spread_json(r.ms, &Spread::q1) << ",\n"

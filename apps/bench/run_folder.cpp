@@ -3,6 +3,7 @@
 #include <array>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "common/cli.hpp"
 
@@ -26,10 +27,22 @@ void check_writable(const std::string& path) {
   if (!existed) fs::remove(file, error);
 }
 
+void point_latest_at(const std::string& folder) {
+  const fs::path link = fs::path("results") / "latest";
+  std::error_code error;
+  if (fs::is_symlink(link, error) || !fs::exists(link, error)) fs::remove(link, error);
+  fs::create_directory_symlink(folder, link, error);
+  if (error)
+    std::cerr << "fem_bench: warning: cannot point " << link.string() << " at " << folder << ": "
+              << error.message() << "\n";
+  else
+    std::cout << "results/latest -> " << folder << "\n";
+}
+
 int remove_previous_plots(const std::string& json) {
   // The plots scripts/plot_results.py makes of a run.
-  constexpr std::array<const char*, 4> kRunPlots = {"phases.png", "speedup.png", "allocations.png",
-                                                    "solvers.png"};
+  constexpr std::array<const char*, 5> kRunPlots = {
+      "phases.png", "phases_stacked.png", "speedup.png", "allocations.png", "solvers.png"};
   int removed = 0;
   std::error_code error;
   for (const char* name : kRunPlots)
