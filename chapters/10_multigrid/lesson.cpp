@@ -301,7 +301,6 @@ std::string multigrid_table(const LessonRun& run) {
     costs.push_back(measure_costs(mg, b, threads, stats.refreshes, run.steps));
   const FromZero z = from_zero(stepper, scene, solver);
   const std::string per_level = cost_table(mg, costs, spmv, stats, run.steps);
-  std::cerr << "\n" << per_level;
   std::ostringstream t;
   t << main_table(run, mg, stats, z, costs, spmv) << per_level << "\nTolerance "
     << std::defaultfloat << solver.tolerance

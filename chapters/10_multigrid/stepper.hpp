@@ -1,5 +1,5 @@
-// Chapter 10: the solve stops growing with the mesh. Chapter 09's threaded step (the fused
-// element pass, the block SpMV over fixed row chunks, sums in chunk order) with one V-cycle
+// Chapter 10: a solve that grows far more slowly with the mesh. Chapter 09's threaded step (the
+// fused element pass, the block SpMV over fixed row chunks, sums in chunk order) with one V-cycle
 // of smoothed-aggregation multigrid (multigrid.hpp) as the PCG's preconditioner in place of
 // block Jacobi: the preconditioner Tamstorf, Jones & McCormick 2015 pair with their PPCG.
 // The V-cycle runs on every thread of the PCG's team over fixed row blocks, with sums in a
