@@ -89,7 +89,7 @@ void add_roofline_options(ArgParser& args) {
   args.option("threads-max", "N", "the second thread count of the roofs and chapters 09-12",
               std::to_string(hardware_threads()));
   args.option("warmup", "N", "unmeasured steps before the measured ones", "3");
-  args.option("roof-seconds", "S", "time per roof kernel", "0.3");
+  args.option("roof-seconds", "S", "time per roof kernel", "0.2");
 }
 
 }  // namespace
