@@ -38,9 +38,10 @@ commands:
   build      set up if needed and build (preset: \$PRESET, default release)
   test       build and run every test through ctest (ctest arguments may follow, e.g. -L ch01)
   bench      build (quietly) and benchmark every chapter on the poster-sized mesh: prints the
-             per-phase table; a run is a folder, --out DIR (default results) gets bench.json
-             and the plots made from it; other arguments go to fem_bench (--chapters 06,07,
-             --mesh, --scene, --steps; fem_bench --help)
+             per-phase table; a run is a folder, --out DIR (default: a new results/run-DATE-TIME,
+             with results/latest pointing to it) gets bench.json and the plots made from it; a
+             folder holding a run is refused unless --replace; other arguments go to fem_bench
+             (--chapters 06,07, --mesh, --scene, --steps; fem_bench --help)
   diff       a variant's change against its original, the copy's renames undone (the hand-in):
              ./tutorial.sh diff 06_my_fused_updates
   handin-check
@@ -60,7 +61,7 @@ commands:
   threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
              thread on the poster-sized mesh: results/threads.json and results/threads.png
              (step and solve time against threads, with the ideal line)
-  docs       commit the run in results/ as docs/data/*.json and regenerate the generated parts
+  docs       commit the run in results/latest (and results/*.json) as docs/data/*.json and regenerate the generated parts
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the figures of chapters 10-12 (scripts/figures.py), the
@@ -260,25 +261,30 @@ with_heartbeat() {
 # A run is a folder: fem_bench writes DIR/bench.json and the plots are made from that file,
 # so plots and numbers always belong together.
 bench() {
-  local out=results json="" args=("$@") i  # fem_bench's defaults
+  local out="" json="" args=("$@") i
   for ((i = 0; i < ${#args[@]}; i++)); do
     case "${args[i]}" in
-      --out) out="${args[i + 1]:-}" ;;
+      --out) out="${args[i + 1]:-}"; [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; } ;;
       --json) json="${args[i + 1]:-}" ;;
     esac
   done
-  [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; }
-  [ -n "$json" ] || json="$out/bench.json"
   # The run's folder before the build and the run (fem_bench checks its other arguments before
-  # its work, too): a place that cannot be written fails now, not minutes later.
-  if ! mkdir -p "$out" 2>/dev/null || [ ! -w "$out" ]; then
-    echo "tutorial.sh bench: cannot write the run's folder '$out'" >&2
+  # its work, too): a place that cannot be written fails now, not minutes later. Without --out,
+  # fem_bench makes a new folder results/run-DATE-TIME and points results/latest at it: a run
+  # never replaces an earlier one unless asked (--replace).
+  if ! mkdir -p "${out:-results}" 2>/dev/null || [ ! -w "${out:-results}" ]; then
+    echo "tutorial.sh bench: cannot write the run's folder '${out:-results}'" >&2
     exit 2
   fi
   quiet_build
-  log "benchmarking: fem_bench $* (the run's folder: $out/)"
+  log "benchmarking: fem_bench $* (the run's folder: ${out:-a new one under results/})"
   "$BUILD_DIR/fem_bench" "$@"
-  plots "$json" "$out"
+  if [ -n "$json" ]; then
+    plots "$json" "${out:-$(dirname "$json")}"
+  else
+    out="${out:-results/$(readlink results/latest)}"
+    plots "$out/bench.json" "$out"
+  fi
 }
 
 # Plots of one run from its JSON: ./tutorial.sh plots DIR (or a bench.json and a folder).
@@ -387,11 +393,14 @@ roofline() {
 
 docs() {
   quiet_build
-  [ -f results/bench.json ] || { echo "no results/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
+  local run=results/latest
+  [ -f "$run/bench.json" ] || run=results  # a run made before runs had folders of their own
+  [ -f "$run/bench.json" ] || { echo "no results/latest/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
   lessons
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
-  for json in bench scaling viewer regimes threads; do
+  cp "$run/bench.json" docs/data/bench.json
+  for json in scaling viewer regimes threads; do
     if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
   done
   "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images

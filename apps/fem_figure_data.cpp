@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/node_order.hpp"
 #include "common/cli.hpp"
@@ -33,22 +34,36 @@ std::string mesh_record(const ArgParser& args, const Scene& scene) {
          ",\n  \"tet_checksum\": " + std::to_string(checksum) + ",\n";
 }
 
+// Per node of a level with a level below: its aggregate, read from the level's own data (the
+// column of its tentative block in P; the aggregation's set-up data is gone after set-up).
+template <int B>
+std::vector<int> aggregates(const ch10::Level<B>& level) {
+  const ch10::Transfer<B>& transfer = level.transfer;
+  std::vector<int> out(transfer.tentative_block.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = transfer.P.column[transfer.tentative_block[i]];
+  return out;
+}
+
 // Chapter 10: the hierarchy as the stepper sets it up (set-up only, no step), per level its
 // size and the smoothing steps of its V-cycle, per node of a non-coarsest level its aggregate.
 void hierarchy(std::ostream& out, const Scene& scene) {
   const ch10::MultigridStepper stepper(scene, SolverSettings{});
   const ch10::Multigrid& mg = stepper.multigrid();
-  const bool chebyshev = mg.settings().smoother == ch10::MultigridSettings::Smoother::Chebyshev;
+  const ch10::SmootherSettings& relax = mg.settings().relax;
+  const bool chebyshev = relax.smoother == ch10::Smoother::Chebyshev;
   out << "  \"smoother\": \"" << (chebyshev ? "Chebyshev" : "other") << "\",\n"
-      << "  \"smoothing_steps\": "
-      << (chebyshev ? mg.settings().chebyshev_degree : mg.settings().sweeps)
+      << "  \"smoothing_steps\": " << (chebyshev ? relax.chebyshev_degree : relax.sweeps)
       << ",\n  \"levels\": [\n";
   for (int l = 0; l < mg.levels(); ++l)
-    out << "    {\"block\": " << (l == 0 ? 3 : ch10::kModes) << ", \"dofs\": " << mg.level_dofs(l)
-        << ", \"blocks\": " << mg.level_blocks(l) << ", \"parts\": " << mg.level_parts(l) << "}"
+    out << "    {\"block\": " << (l == 0 ? 3 : ch10::kModes)
+        << ", \"dofs\": " << ch10::level_dofs(mg, l)
+        << ", \"blocks\": " << ch10::level_blocks(mg, l)
+        << ", \"parts\": " << ch10::level_row_blocks(mg, l) << "}"
         << (l + 1 < mg.levels() ? ",\n" : "\n");
-  out << "  ],\n  \"aggregate\": [\n    " << ints(mg.fine_level().aggregate);
-  for (int l = 1; l + 1 < mg.levels(); ++l) out << ",\n    " << ints(mg.coarse_level(l).aggregate);
+  out << "  ],\n  \"aggregate\": [\n    " << ints(aggregates(mg.fine_level()));
+  for (int l = 1; l + 1 < mg.levels(); ++l)
+    out << ",\n    " << ints(aggregates(mg.coarse_levels()[l - 1]));
   out << "\n  ]\n";
 }
 

@@ -67,34 +67,47 @@ bool ArgParser::parse(int argc, const char* const* argv) {
   return true;
 }
 
-const std::string& ArgParser::get(const std::string& name) const { return options_.at(name).value; }
+namespace {
 
-double ArgParser::get_double(const std::string& name) const {
-  const std::string& s = get(name);
+// std::stoi or std::stod on the whole of s, without their exceptions.
+template <class Number, class Convert>
+std::optional<Number> parse_number(const std::string& s, Convert convert) {
   std::size_t used = 0;
-  double v = 0.0;
+  Number v{};
   try {
-    v = std::stod(s, &used);
+    v = convert(s, &used);
   } catch (const std::exception&) {
-    used = 0;
+    return std::nullopt;
   }
-  if (used == 0 || used != s.size() || !std::isfinite(v))
-    throw UsageError("--" + name + " expects a finite number, got '" + s + "'");
+  if (used == 0 || used != s.size()) return std::nullopt;
   return v;
 }
 
+}  // namespace
+
+std::optional<int> parse_int(const std::string& s) {
+  return parse_number<int>(
+      s, [](const std::string& t, std::size_t* used) { return std::stoi(t, used); });
+}
+
+std::optional<double> parse_double(const std::string& s) {
+  return parse_number<double>(
+      s, [](const std::string& t, std::size_t* used) { return std::stod(t, used); });
+}
+
+const std::string& ArgParser::get(const std::string& name) const { return options_.at(name).value; }
+
+double ArgParser::get_double(const std::string& name) const {
+  const std::optional<double> v = parse_double(get(name));
+  if (!v || !std::isfinite(*v))
+    throw UsageError("--" + name + " expects a finite number, got '" + get(name) + "'");
+  return *v;
+}
+
 int ArgParser::get_int(const std::string& name) const {
-  const std::string& s = get(name);
-  std::size_t used = 0;
-  int v = 0;
-  try {
-    v = std::stoi(s, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != s.size())
-    throw UsageError("--" + name + " expects an integer, got '" + s + "'");
-  return v;
+  const std::optional<int> v = parse_int(get(name));
+  if (!v) throw UsageError("--" + name + " expects an integer, got '" + get(name) + "'");
+  return *v;
 }
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +17,10 @@ namespace fem {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// The whole of s as a number; nullopt when it is none (empty, trailing text, out of range).
+std::optional<int> parse_int(const std::string& s);
+std::optional<double> parse_double(const std::string& s);
 
 class ArgParser {
  public:

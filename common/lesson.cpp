@@ -1,21 +1,23 @@
 #include "common/lesson.hpp"
 
-#include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include "common/build_info.hpp"
+#include "common/mesh.hpp"
 
 namespace fem {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 void progress(const std::string& what) {
   std::cerr << "  fem_lessons: " << what << "\n" << std::flush;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << v;
+  return out.str();
 }
 
 std::string code(const std::string& s) {
@@ -31,6 +33,18 @@ std::string mesh_name(const Scene& scene) {
 std::string measured_on() {
   const BuildInfo info = build_info();
   return cpu_model() + ", " + info.compiler + ", `" + info.flags + "`";
+}
+
+std::vector<Scene> more_meshes(const LessonRun& run) {
+  std::vector<Scene> scenes;
+  std::stringstream list(run.args.get("meshes"));
+  for (std::string path; std::getline(list, path, ',');) {
+    if (path.empty()) continue;
+    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
+    scenes.back().dt = run.scene.dt;
+    scenes.back().damping = run.scene.damping;
+  }
+  return scenes;
 }
 
 }  // namespace fem

@@ -11,6 +11,7 @@
 
 #include "common/cli.hpp"
 #include "common/scene.hpp"
+#include "common/statistics.hpp"
 
 namespace fem {
 
@@ -44,8 +45,6 @@ struct Lesson {
 
 // ---- what the measurements share ----------------------------------------------------------
 
-double median(std::vector<double> v);
-
 // Median wall-clock milliseconds (std::chrono::steady_clock) of f, run `repeat` times but
 // stopped once `budget_s` seconds are spent (after one run at least), so that a lesson on a
 // large mesh finishes in bounded time.
@@ -55,6 +54,9 @@ double time_ms(int repeat, F&& f, double budget_s = 10.0);
 // Progress of a long lesson, on stderr so that stdout stays the Markdown table.
 void progress(const std::string& what);
 
+// v with `digits` digits after the point, for a table cell.
+std::string fixed(double v, int digits);
+
 // `s` as Markdown code, with '|' replaced so that a table cell stays intact.
 std::string code(const std::string& s);
 
@@ -63,6 +65,11 @@ std::string mesh_name(const Scene& scene);
 
 // "AMD EPYC ..., GNU 12.2.0, `-O3 ...`": where and how a table was measured.
 std::string measured_on();
+
+// The run's scene (its name, material, time step and damping) on each mesh of the lesson's
+// comma-separated --meshes option: a table for each. All are loaded before any is measured,
+// so that a bad path fails at once.
+std::vector<Scene> more_meshes(const LessonRun& run);
 
 // ---- definitions of the templates -----------------------------------------------------
 

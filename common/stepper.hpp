@@ -72,7 +72,7 @@ class Stepper {
   // the viewer's mouse spring. The storage is reused, so once it has held as many
   // nonzeros this allocates nothing. Throws std::invalid_argument for a node out of
   // range or a non-finite force. (Virtual so that on_one_thread's wrapper can pass them on,
-  // and chapter 11, which numbers the nodes its own way, can rename them.)
+  // and a stepper that numbers the nodes its own way can rename them.)
   virtual void set_external_forces(const std::vector<ExternalForce>& forces);
   virtual const Eigen::SparseVector<double>& external_forces() const { return f_ext_; }
 

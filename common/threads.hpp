@@ -27,8 +27,9 @@ int max_threads();
 void set_threads(int n);
 
 // The most threads a program accepts on its command line: kOversubscription times the
-// hardware threads. More threads than cores only wait for each other at every barrier (a
-// 20-step run at --threads 999 on 2 cores took 60 times as long as at 2).
+// hardware threads. More threads than cores only wait for each other at every barrier, each
+// barrier waiting for threads the system has not scheduled yet: a count far above the cores
+// is a typo, refused at once rather than run for many times as long.
 constexpr int kOversubscription = 4;
 int thread_limit();
 // Checks a thread count asked for on the command line before any work: throws

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes docs/diffs/NN_name.diff: the lesson of each chapter as a diff against the chapter
 before. Every source file of the chapter's folder (.hpp, .cpp) is diffed against the file of
-the same name in the previous chapter; a file the previous chapter does not have shows as
+the same name in the previous chapter, in reading order (source_files); a file the previous chapter does not have shows as
 added, and so does a file that includes its namesake of the previous chapter (chapter 10's
 stepper extends chapter 09's instead of copying it), as do the lesson measurements
 (lesson.hpp, lesson.cpp), which never copy forward. Before diffing, the previous chapter's
@@ -55,7 +55,19 @@ def renamed(text, old, new):
 
 
 def source_files(chapter):
-    return sorted(p for p in chapter.iterdir() if p.suffix in (".hpp", ".cpp"))
+    """The chapter's sources in reading order: the headers (the interfaces) before the sources,
+    and within each the stepper first, then the building blocks in the order in which the
+    chapter's README first names them (a file it never names after those, alphabetically),
+    the lesson's measurements last."""
+    readme_path = chapter / "README.md"
+    readme = readme_path.read_text() if readme_path.exists() else ""
+
+    def key(path):
+        stem = path.stem
+        named = re.search(rf"\b{re.escape(stem)}\.(?:hpp|cpp)\b", readme)
+        role = 0 if stem == "stepper" else 2 if stem == "lesson" else 1
+        return (path.suffix != ".hpp", role, named.start() if named else len(readme), path.name)
+    return sorted((p for p in chapter.iterdir() if p.suffix in (".hpp", ".cpp")), key=key)
 
 
 def file_diff(previous, current, name, root):

@@ -28,9 +28,47 @@ def finish(fig, data, path):
     fig.text(0.01, 0.005, text, fontsize=6.5, color="firebrick" if busy else "0.35", ha="left",
              va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.08 if busy else 0.05, 1, 1))
+    problems = layout_problems(fig)
+    if problems:
+        plt.close(fig)
+        raise ResultsError(f"{path.name}: the layout hides what it shows: " + "; ".join(problems))
     fig.savefig(path, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
+
+
+def layout_problems(fig):
+    """What a reader could not read, found from the drawn figure: a legend box over a bar or
+    a marker of its axes, and tick labels of one axis that run into each other."""
+    renderer = fig.canvas.get_renderer()
+    problems = []
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is not None:
+            box = legend.get_window_extent(renderer)
+            covered = [a for a in list(ax.patches) + list(ax.collections)
+                       if a.get_visible() and a.get_window_extent(renderer).overlaps(box)
+                       and a.get_window_extent(renderer).width > 0]
+            if covered:
+                problems.append(f"the legend of '{ax.get_title()}' covers {len(covered)} marks")
+        for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            # Slanted labels (the allocation plot's) have boxes that overlap by design: their
+            # text runs parallel, apart. Only level labels are checked.
+            boxes = [t.get_window_extent(renderer) for t in axis.get_ticklabels(which="both")
+                     if t.get_visible() and t.get_text() and t.get_rotation() == 0]
+            if any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:]):
+                problems.append(f"the {name} tick labels of '{ax.get_title()}' overlap")
+    return problems
+
+
+def ratio_ticks(ax):
+    """A log axis of ratios labelled x0.5, x1, x2 (no "1.05 x 10^0"): minor ticks are labelled
+    only when the axis spans less than a decade, where there are too few major ones."""
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+    label = FuncFormatter(lambda v, _: f"x{v:.3g}")
+    ax.yaxis.set_major_formatter(label)
+    low, high = ax.get_ylim()
+    ax.yaxis.set_minor_formatter(label if high / low < 10 else NullFormatter())
 
 
 def chapter_labels(chapters):
@@ -129,7 +167,8 @@ def plot_phases_stacked(data, out):
     ax.set_xlim(0, 1.15 * max(r[2] for r in rows))
     ax.set_xlabel(f"median time per step [ms]; at the end: the step and its speedup over {rows[0][0]}")
     ax.set_title(f"The course at a glance: the step split into its phases ({run_label(data)})")
-    ax.legend(fontsize=8, loc="lower right", title="phase (median per step)", title_fontsize=8)
+    # Beside the axes: inside them, a run with few rows (a variant's) has no free corner.
+    legend_outside(ax, "phase (median per step)")
     ax.grid(axis="x", alpha=0.3)
     finish(fig, data, out / "phases_stacked.png")
 
@@ -191,7 +230,10 @@ def plot_speedup(data, out):
                edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
-    ax.set_xticks(x, [PHASE_LABELS[p] for p in phases])
+    # Two lines a label: the legend beside the axes narrows them, and a variant's long names
+    # widen the legend.
+    ax.set_xticks(x, [PHASE_LABELS[p].replace(" ", "\n", 1) for p in phases])
+    ratio_ticks(ax)
     ax.set_ylabel(f"{ylabel} (median ratio, log)")
     ax.set_title(title + (", beside the poster's" if poster else "") + f" ({run_label(data)})")
     legend_outside(ax, "-: a phase at 0 ms, no ratio")
@@ -246,10 +288,18 @@ def plot_solvers(data, out):
     if comparable_to_poster(data):  # absolute times compare only on the poster's run
         poster = [POSTER_SOLVE_MS.get(n) for n in names]
         ys = [i for i, p in enumerate(poster) if p is not None]
-        ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3, label="poster")
-    ax1.legend(fontsize=8, loc="lower right")
+        ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3,
+                    clip_on=False, label="poster")
+    # A log axis: the solvers span two decades, and the poster's few milliseconds would sit
+    # squashed against zero on a linear one. The legend below the axes covers no bar.
+    ax1.set_xscale("log")
+    values = [v for s in solvers for v in (s.get("setup_ms", 0), s.get("solve_ms", 0),
+                                           s.get("median_ms", 0)) if v > 0]
+    if values:  # a bar from 0 (no set-up) would stretch a log axis down to its smallest tick
+        ax1.set_xlim(max(min(values) / 2, max(values) / 1e4), max(values) * 2)
+    ax1.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, frameon=False)
     ax1.invert_yaxis()
-    ax1.set_xlabel("median time per solve [ms]")
+    ax1.set_xlabel("median time per solve [ms, log]")
     ax1.set_title("Time per solve")
     ax2.barh(names, [s["iterations"] for s in solvers], color="tab:green")
     ax2.invert_yaxis()

@@ -2,6 +2,7 @@
 the phases, the poster's reported numbers, and the footer every plot and table carries."""
 import json
 import pathlib
+import re
 import sys
 
 PHASES = ["dfdx", "compose", "constraints", "solve", "step"]
@@ -135,6 +136,13 @@ def validate_bench(data):
         if isinstance(c, dict) and "threads" in c and need(c, "threads", int, where) is not None \
                 and c["threads"] < 1:
             problems.append(f"{where}.threads: expected >= 1, got {c['threads']}")
+        if isinstance(c, dict) and "source_hash" in c and not (
+                isinstance(c["source_hash"], str) and re.fullmatch(r"[0-9a-f]{64}", c["source_hash"])):
+            problems.append(f"{where}.source_hash: expected a SHA-256 in hex, got {c['source_hash']!r}")
+    rows = [c.get("chapter") for c in chapters or [] if isinstance(c, dict)]
+    for row in sorted({r for r in rows if rows.count(r) > 1}):
+        problems.append(f"bench.chapters: the row {row} stands {rows.count(row)} times (a chapter "
+                        "measured twice in one run)")
     for i, s in enumerate(data.get("solvers", [])):
         where = f"solvers[{i}]"
         need(s, "name", str, where)

@@ -197,9 +197,9 @@ inline void check_damping_rate(const std::string& chapter) {
 // At the tolerance the benchmark and the viewer use (SolverSettings{}: 1e-4), the chapters
 // solve to different errors (warm start, another preconditioner): they drift apart, but
 // boundedly. Over kDefaultToleranceSteps steps of the driven scene the drift must stay below
-// kDefaultToleranceDrift = 10 x the tolerance, relative to the motion. Measured (GCC 12,
-// Eigen 3.4.0): 3.2e-5 for chapter 06 and 3.8e-5 for 07; about 7e-14 for 02 to 05, which
-// run Eigen's CG from zero like chapter 01 and differ only by rounding.
+// kDefaultToleranceDrift = 10 x the tolerance, relative to the motion: the chapters that
+// start from a guess or precondition otherwise (06 on) drift by the order of the tolerance;
+// 02 to 05 run Eigen's CG from zero like chapter 01 and differ only by rounding.
 constexpr int kDefaultToleranceSteps = 100;
 constexpr double kDefaultToleranceDrift = 1e-3;
 inline void check_drift_at_default_tolerance(const std::string& chapter) {

@@ -4,6 +4,7 @@
 
 #include "apps/roofline/work.hpp"
 #include "chapters/10_multigrid/multigrid.hpp"
+#include "chapters/10_multigrid/report.hpp"
 
 namespace fem::roofline {
 
@@ -12,24 +13,24 @@ std::vector<LevelSize> multigrid_levels(const ch10::Multigrid& multigrid) {
   for (int l = 0; l < multigrid.levels(); ++l) {
     LevelSize level;
     level.block = l == 0 ? 3 : ch10::kModes;
-    level.nodes = multigrid.level_dofs(l) / level.block;
-    level.blocks = multigrid.level_blocks(l);
+    level.nodes = ch10::level_dofs(multigrid, l) / level.block;
+    level.blocks = ch10::level_blocks(multigrid, l);
     level.coarsest = l + 1 == multigrid.levels();
-    level.transfer = level.coarsest ? 0 : multigrid.prolongator_blocks(l);
+    level.transfer = level.coarsest ? 0 : ch10::prolongator_blocks(multigrid, l);
     levels.push_back(level);
   }
   return levels;
 }
 
 int smoother_products(const ch10::Multigrid& multigrid) {
-  using Smoother = ch10::MultigridSettings::Smoother;
-  const ch10::MultigridSettings& s = multigrid.settings();
+  using ch10::Smoother;
+  const ch10::SmootherSettings& s = multigrid.settings().relax;
   // A polynomial smoother from zero skips the product of its first step; the residual adds
-  // one: pre (steps - 1) + residual (1) + post (steps) products (Multigrid::cycle).
+  // one: pre (steps - 1) + residual (1) + post (steps) products (ch10::v_cycle, smooth).
   if (s.smoother == Smoother::Chebyshev) return 2 * s.chebyshev_degree * s.sweeps;
   if (s.smoother == Smoother::Jacobi) return 2 * s.sweeps;
   // Gauss-Seidel: a sweep reads the matrix once; after a single forward sweep the residual
-  // comes with it.
+  // comes with it (ch10::residual).
   return 2 * s.sweeps + (s.sweeps == 1 ? 0 : 1);
 }
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "apps/viewer/picking.hpp"
+#include "common/cli.hpp"
 
 namespace fem::viewer {
 
@@ -64,13 +65,9 @@ DragReplay DragReplay::parse(const std::string& spec, int total_frames) {
   std::stringstream in(spec);
   std::string item;
   while (std::getline(in, item, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--replay-drag: '" + item + "' is not a number");
-    }
+    const std::optional<double> value = parse_double(item);
+    if (!value) throw std::invalid_argument("--replay-drag: '" + item + "' is not a number");
+    values.push_back(*value);
   }
   if (values.size() != 4)
     throw std::invalid_argument(

@@ -248,21 +248,42 @@ fv::MouseInput mouse_from(GLFWwindow* window) {
   return mouse;
 }
 
+fv::PanelState initial_panel(const fv::Session& session, const Options& options) {
+  fv::PanelState panel;
+  panel.edited = session.settings();
+  panel.paused = options.paused;
+  panel.mode = options.fixed_dt ? fv::StepMode::FixedDt : fv::StepMode::OneStepPerFrame;
+  const std::string& mesh = session.scene().mesh.file;
+  panel.meshes = list_meshes(mesh);
+  panel.mesh_index = static_cast<int>(std::find(panel.meshes.begin(), panel.meshes.end(), mesh) -
+                                      panel.meshes.begin());
+  return panel;
+}
+
+// The dragged node where the grab began, and where the mouse pulls it now.
+void record_grab(const fv::Session& session, bool had_grab, RunRecord& record) {
+  if (!had_grab && session.grabbed()) {
+    record.grabbed_node = session.grabbed()->node;
+    record.node_at_grab = session.state().x.segment<3>(3 * record.grabbed_node);
+  }
+  if (session.grabbed()) record.target = session.grabbed()->target;
+}
+
+void report_run(const RunRecord& record, const fv::Session& session, const Options& options) {
+  std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("
+            << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
+            << session.chapter() << ", mean step "
+            << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1) << " ms\n";
+  if (!options.report.empty()) write_report(options.report, record, session);
+}
+
 void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Options& options) {
   fv::Renderer renderer;
   renderer.set_scene(session->scene());
   fv::OrbitCamera camera;
-  const fem::TetMesh& mesh = session->scene().mesh;
-  frame_beside_panel(camera, mesh);
+  frame_beside_panel(camera, session->scene().mesh);
   fv::MouseControls controls;
-  fv::PanelState panel;
-  panel.edited = session->settings();
-  panel.paused = options.paused;
-  panel.mode = options.fixed_dt ? fv::StepMode::FixedDt : fv::StepMode::OneStepPerFrame;
-  panel.meshes = list_meshes(mesh.file);
-  panel.mesh_index = static_cast<int>(
-      std::find(panel.meshes.begin(), panel.meshes.end(), mesh.file) - panel.meshes.begin());
-
+  fv::PanelState panel = initial_panel(*session, options);
   std::optional<fv::DragReplay> replay = options.replay;  // it remembers where it started
   RunRecord record;
   const auto start = std::chrono::steady_clock::now();
@@ -281,11 +302,7 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
     const bool had_grab = session->grabbed().has_value();
     controls.update(mouse, !replay && ImGui::GetIO().WantCaptureMouse, width, height, camera,
                     *session);
-    if (!had_grab && session->grabbed()) {
-      record.grabbed_node = session->grabbed()->node;
-      record.node_at_grab = session->state().x.segment<3>(3 * record.grabbed_node);
-    }
-    if (session->grabbed()) record.target = session->grabbed()->target;
+    record_grab(*session, had_grab, record);
 
     const auto now = std::chrono::steady_clock::now();
     const double frame_seconds = std::chrono::duration<double>(now - last_frame).count();
@@ -308,19 +325,11 @@ void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Option
     record.paused = panel.paused;
   }
   record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("
-            << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
-            << session->chapter() << ", mean step "
-            << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1) << " ms\n";
-  if (!options.report.empty()) write_report(options.report, record, *session);
+  report_run(record, *session, options);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  using namespace fem;
-  ArgParser args("fem_viewer",
-                 "Real-time viewer: drag the body with the mouse, switch chapters live.");
+void add_viewer_options(fem::ArgParser& args) {
+  using fem::latest_chapter;
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
   add_thread_option(args);
@@ -337,55 +346,65 @@ int main(int argc, char** argv) {
   args.option("report", "FILE", "write the run's facts as JSON (frame rate, dragged node)", "");
   args.flag("fixed-dt", "start in fixed-dt mode (simulated time follows the wall clock)");
   args.flag("paused", "start paused (space resumes): --frames then measures drawing alone");
+}
+
+Options viewer_options(const fem::ArgParser& args) {
+  using fem::UsageError;
+  Options options;
   try {
-    if (!args.parse(argc, argv)) return 0;
-    Options options;
+    options.chapter = fem::find_chapter(args.get("chapter")).id;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  options.frames = args.get_int("frames");
+  options.width = args.get_int("width");
+  options.height = args.get_int("height");
+  options.screenshot = args.get("screenshot");
+  options.report = args.get("report");
+  options.fixed_dt = args.has_flag("fixed-dt");
+  options.paused = args.has_flag("paused");
+  if (options.frames < 0) throw UsageError("--frames must be >= 0");
+  if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
+    throw UsageError("--width and --height must be in [64, 8192]");
+  const bool scripted = !args.get("replay-drag").empty() || !options.screenshot.empty();
+  if (scripted && options.frames == 0)
+    throw UsageError("--replay-drag and --screenshot need --frames N");
+  if (!args.get("replay-drag").empty()) {
     try {
-      options.chapter = find_chapter(args.get("chapter")).id;
+      options.replay = fv::DragReplay::parse(args.get("replay-drag"), options.frames);
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }
-    options.frames = args.get_int("frames");
-    options.width = args.get_int("width");
-    options.height = args.get_int("height");
-    options.screenshot = args.get("screenshot");
-    options.report = args.get("report");
-    options.fixed_dt = args.has_flag("fixed-dt");
-    options.paused = args.has_flag("paused");
-    if (options.frames < 0) throw UsageError("--frames must be >= 0");
-    if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
-      throw UsageError("--width and --height must be in [64, 8192]");
-    const bool scripted = !args.get("replay-drag").empty() || !options.screenshot.empty();
-    if (scripted && options.frames == 0)
-      throw UsageError("--replay-drag and --screenshot need --frames N");
-    if (!args.get("replay-drag").empty()) {
-      try {
-        options.replay = fv::DragReplay::parse(args.get("replay-drag"), options.frames);
-      } catch (const std::invalid_argument& e) {
-        throw UsageError(e.what());
-      }
-    }
-    const int threads = threads_from_args(args);
-    const Scene scene = scene_from_args(args);
-    fv::SessionSettings settings;
-    settings.scene = scene.name;
-    settings.material = scene.material;
-    settings.damping = scene.damping;
-    settings.dt = scene.dt;
-    settings.solver = solver_from_args(args);
-    auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
-    std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
-              << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", " << threads
-              << " threads for the parallel chapters\n";
-
-    const Window window(options);
-    run(window.handle, session, options);
-  } catch (const UsageError& e) {
-    std::cerr << "fem_viewer: " << e.what() << " (see fem_viewer --help)\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "fem_viewer: error: " << e.what() << "\n";
-    return 1;
   }
+  return options;
+}
+
+int run_viewer(const fem::ArgParser& args) {
+  using namespace fem;
+  const Options options = viewer_options(args);
+  const int threads = threads_from_args(args);
+  const Scene scene = scene_from_args(args);
+  fv::SessionSettings settings;
+  settings.scene = scene.name;
+  settings.material = scene.material;
+  settings.damping = scene.damping;
+  settings.dt = scene.dt;
+  settings.solver = solver_from_args(args);
+  auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
+  std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
+            << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", " << threads
+            << " threads for the parallel chapters\n";
+  const Window window(options);
+  run(window.handle, session, options);
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fem::ArgParser args("fem_viewer",
+                      "Real-time viewer: drag the body with the mouse, switch chapters live.");
+  add_viewer_options(args);
+  return fem::run_program("fem_viewer",
+                          [&] { return args.parse(argc, argv) ? run_viewer(args) : 0; });
 }

@@ -248,28 +248,32 @@ void filter(const std::vector<NodeConstraint>& constraints, Eigen::VectorXd& v) 
   for (const auto& c : constraints) v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
 }
 
+// The work vectors sized (they allocate on the first solve only: the sizes never change) and
+// Jacobi from the diagonal, read through the offsets: no search, no copy of A.
+void prepare(const Eigen::SparseMatrix<double>& A, const std::vector<int>& diagonal_offsets,
+             PcgWorkspace& work) {
+  const Eigen::Index n = A.cols();
+  auto& [r, s, p, q, inverse_diagonal] = work;
+  r.resize(n);
+  s.resize(n);
+  p.resize(n);
+  q.resize(n);
+  inverse_diagonal.resize(n);
+  const double* values = A.valuePtr();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double d = values[diagonal_offsets[k]];
+    inverse_diagonal[k] = d != 0.0 ? 1.0 / d : 1.0;  // as Eigen's DiagonalPreconditioner
+  }
+}
+
 }  // namespace
 
 SolveStats pcg_solve(const Eigen::SparseMatrix<double>& A, const Eigen::VectorXd& b,
                      const std::vector<NodeConstraint>& constraints,
                      const std::vector<int>& diagonal_offsets, const SolverSettings& settings,
                      PcgWorkspace& work, Eigen::VectorXd& y) {
-  const Eigen::Index n = b.size();
+  prepare(A, diagonal_offsets, work);
   auto& [r, s, p, q, inverse_diagonal] = work;
-  // Same sizes every step: these resizes allocate on the first solve only.
-  r.resize(n);
-  s.resize(n);
-  p.resize(n);
-  q.resize(n);
-  inverse_diagonal.resize(n);
-
-  // Jacobi from the diagonal, read through the offsets: no search, no copy of A.
-  const double* values = A.valuePtr();
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const double d = values[diagonal_offsets[k]];
-    inverse_diagonal[k] = d != 0.0 ? 1.0 / d : 1.0;  // as Eigen's DiagonalPreconditioner
-  }
-
   SolveStats result;
   const double rhs_norm2 = b.squaredNorm();
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0

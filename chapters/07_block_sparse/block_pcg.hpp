@@ -1,5 +1,5 @@
 // Chapter 07's solver: chapter 06's PCG on the block matrix, preconditioned by block Jacobi
-// (the inverse of each node's 3x3 diagonal block). Chapter 08 includes it.
+// (the inverse of each node's 3x3 diagonal block).
 #pragma once
 
 #include <Eigen/Core>

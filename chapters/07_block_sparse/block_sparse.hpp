@@ -1,7 +1,7 @@
 // Chapter 07's building block: a sparse matrix of small dense blocks in block compressed
 // rows, what Eigen's unsupported BlockSparseMatrix would have been. The stepper's matrices
-// are 3x3 blocks (one per pair of nodes that share a tetrahedron); chapter 10's multigrid
-// hierarchy stores 6x6 and 3x6 blocks in the same type. Chapters 08-10 include this file.
+// are 3x3 blocks (one per pair of nodes that share a tetrahedron); the block size is a
+// parameter, so any R x C blocks (6x6, 3x6) are stored the same way.
 #pragma once
 
 #include <Eigen/Core>
@@ -37,7 +37,7 @@ struct BlockCsr {
   // Index of block (i, j) in blocks, found by a binary search: for set-up only. -1 if absent.
   int find(int i, int j) const;
   // y_i = sum_j A_ij x_j for the block rows [first, last): each y_i written once, from a sum
-  // kept in registers, so that rows can be shared out between threads (chapter 09).
+  // kept in registers, so that any split of the rows can run on threads of its own.
   void multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first, int last) const {
     for (int i = first; i < last; ++i) {
       Eigen::Matrix<double, R, 1> sum = Eigen::Matrix<double, R, 1>::Zero();

@@ -12,14 +12,7 @@ ElementShape make_element_shape(const ElementRest& rest, const Lame& lame) {
 
 namespace {
 
-// Below this det F / (|F|^2 / 3)^(3/2) (1 for a rotation, 0 for a flat element) Newton is
-// not asked: an inverted element's polar rotation has det -1 and common/ flips it to +1
-// by a convention that only the SVD knows, and near det F = 0 the sign itself is rounding.
-constexpr double kMinRelativeDet = 1e-4;
-// Newton converges quadratically: once a step is below 1e-8 rad, the next would be below
-// about 1e-16, rounding. The cap stops a start far from the answer (then the SVD decides).
-constexpr double kConvergedStep = 1e-8;
-constexpr int kMaxIterations = 12;
+using namespace newton;
 
 // |q|^2 R(q / |q|), the rotation of a quaternion that need not be unit, without a division.
 Eigen::Matrix3d scaled_rotation(const Eigen::Quaterniond& q) {
@@ -67,7 +60,8 @@ int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q) {
     // A, and so H, carries the factor |q|^2: the singularity test is scaled with it.
     const double q2 = q.squaredNorm();
     Eigen::Vector3d w;
-    if (!solve_positive_definite(H, axial, 1e-12 * q2 * q2 * q2 * scale2 * std::sqrt(scale2), w))
+    if (!solve_positive_definite(
+            H, axial, kMinRelativeHessianDet * q2 * q2 * q2 * scale2 * std::sqrt(scale2), w))
       return -1;
     // exp([w]) to second order as the quaternion (1, w/2): a rotation once normalized, and
     // Newton's quadratic convergence is kept.

@@ -1,8 +1,7 @@
 // Chapter 08's building block: the element loop at the speed of its arithmetic. The
 // rotation by Newton's method warm-started from the last steps' rotations (instead of an SVD),
 // the blocks of -df/dx in closed form from the shape gradients (instead of R K0 R^T with a
-// stored K0), and the fused terms of one element: what it adds to b and to A. Chapters 09 and
-// 10 include this file.
+// stored K0), and the fused terms of one element: what it adds to b and to A.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +21,22 @@ struct ElementShape {
   double lambda_volume;    // V lambda
 };
 ElementShape make_element_shape(const ElementRest& rest, const Lame& lame);
+
+// Newton's decisions, shared by every loop that computes these rotations (element by element
+// or several elements at once), so that each decides as newton_polar_rotation does.
+namespace newton {
+// Below this det F / (|F|^2 / 3)^(3/2) (1 for a rotation, 0 for a flat element) Newton is
+// not asked: an inverted element's polar rotation has det -1 and common/ flips it to +1
+// by a convention that only the SVD knows, and near det F = 0 the sign itself is rounding.
+constexpr double kMinRelativeDet = 1e-4;
+// Below det H = kMinRelativeHessianDet |q|^6 (|F|^2 / 3)^(3/2) (H carries |q|^2 and |F|),
+// H is taken as singular: no Newton step.
+constexpr double kMinRelativeHessianDet = 1e-12;
+// Newton converges quadratically: once a step is below 1e-8 rad, the next would be below
+// about 1e-16, rounding. The cap stops a start far from the answer (then the SVD decides).
+constexpr double kConvergedStep = 1e-8;
+constexpr int kMaxIterations = 12;
+}  // namespace newton
 
 // The rotation of the polar decomposition F = R S by Newton's method on the rotations,
 // started from q (the warm start: predicted from the last steps' rotations) and written

@@ -20,7 +20,8 @@ namespace fem::ch08 {
 using ch07::BlockIndex;
 using ch07::BlockSparseMatrix;
 
-// Chapter 09 derives from this stepper and replaces its three marked phases.
+// The three marked phases are virtual: a derived stepper may replace them and keep the rest
+// of the step.
 class ElementKernelsStepper : public Stepper {
  public:
   ElementKernelsStepper(const Scene& scene, const SolverSettings& settings);

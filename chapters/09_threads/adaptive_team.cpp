@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "common/statistics.hpp"
+
 namespace fem::ch09 {
 
 int AdaptiveTeam::next(int given) {
@@ -56,8 +58,7 @@ void AdaptiveTeam::record(double seconds) {
 double AdaptiveTeam::usual() const {
   double sorted[kWindow];
   std::copy(window_, window_ + kWindow, sorted);
-  std::nth_element(sorted, sorted + kWindow / 2, sorted + kWindow);
-  return sorted[kWindow / 2];
+  return median_in_place(sorted, sorted + kWindow);
 }
 
 }  // namespace fem::ch09

@@ -1,6 +1,10 @@
-// The two pieces of OpenMP this chapter needs, behind a guard so that the chapter also
-// builds (and runs on one thread) without OpenMP.
+// The pieces of OpenMP this chapter and the later ones need, behind a guard so that they also
+// build (and run on one thread) without OpenMP: a region, a static share of a loop, the fixed
+// partition of rows every deterministic loop shares out, and an exact sum of counts.
 #pragma once
+
+#include <algorithm>
+#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -30,11 +34,11 @@ void run_parallel(Body&& body) {
 // called by every thread of a team: this thread's contiguous block of [0, count), as the
 // static schedule hands them out, and the barrier that ends a worksharing loop, run by the
 // destructor when the loop is over (the range lives as long as the loop). Why not the
-// pragma: Debian's libomp 14 (Clang's OpenMP runtime) mallocs and frees a 512-byte buffer in
-// every __kmpc_for_static_init (seen under gdb: a debug trace string formatted in a release
-// library), so every worksharing loop would allocate and the step would not be allocation-free;
-// GCC's libgomp allocates nothing there. Outside a parallel region (one thread) the block is
-// the whole range and the barrier does nothing.
+// pragma: Debian's libomp (Clang's OpenMP runtime) formats a debug trace string into a heap
+// buffer in every __kmpc_for_static_init, release build or not, so every worksharing loop
+// would allocate and the step would not be allocation-free (the chapters' zero-allocation
+// tests would fail under the clang preset); GCC's libgomp allocates nothing there. Outside a
+// parallel region (one thread) the block is the whole range and the barrier does nothing.
 class StaticShare {
  public:
   explicit StaticShare(int count) : StaticShare(0, count) {}
@@ -69,5 +73,58 @@ class StaticShare {
  private:
   int begin_ = 0, end_ = 0;
 };
+
+// A fixed partition of `rows` rows (of a block compressed pattern, row_start with rows + 1
+// entries) into `count` ranges of about the same number of stored blocks: range c holds rows
+// start[c] .. start[c+1]-1. Equal blocks rather than equal rows, because an SpMV costs per
+// block. A function of the pattern and the count alone, never of the thread count: every
+// loop over the ranges, and every sum of per-range sums, is then the same for any team.
+inline std::vector<int> equal_block_partition(const std::vector<int>& row_start, int count) {
+  const int rows = static_cast<int>(row_start.size()) - 1;
+  const long long blocks = row_start.back();
+  std::vector<int> start(count + 1, rows);
+  start[0] = 0;
+  for (int c = 1, i = 0; c < count; ++c) {
+    const long long target = blocks * c / count;
+    while (i < rows && row_start[i] < target) ++i;
+    start[c] = i;
+  }
+  return start;
+}
+
+// body(first, last) on each range of a fixed partition (equal_block_partition): shared out
+// between the threads of the team by a StaticShare (a static schedule, a barrier at its end)
+// when collective, all on this thread otherwise (inside a `single`, where no loop may be
+// shared).
+template <class Body>
+void for_parts(const std::vector<int>& start, bool collective, Body&& body) {
+  const int count = static_cast<int>(start.size()) - 1;
+  if (collective) {
+    for (const int p : StaticShare(count)) body(start[p], start[p + 1]);
+  } else {
+    for (int p = 0; p < count; ++p) body(start[p], start[p + 1]);
+  }
+}
+
+// body() on one thread of the team (the others wait at the end), or here.
+template <class Body>
+void on_one_thread(bool collective, Body&& body) {
+  if (collective) {
+#pragma omp single
+    body();
+  } else {
+    body();
+  }
+}
+
+// total += mine, from every thread once. An integer sum is exact in any order, so this
+// atomic leaves the result independent of the threads. (Not an OpenMP reduction: OpenMP
+// requires a reduction variable of an orphaned loop to be shared in the enclosing region,
+// which a variable a lambda captures is not visibly, and Clang holds to it: "reduction
+// variable must be shared".)
+inline void add_count(long long& total, long long mine) {
+#pragma omp atomic
+  total += mine;
+}
 
 }  // namespace fem::ch09

@@ -11,23 +11,11 @@
 
 namespace fem::ch09 {
 
-RowChunks::RowChunks(const BlockSparseMatrix& pattern) {
-  // Equal numbers of blocks rather than of rows: the SpMV, the largest loop, costs per
-  // block. The boundaries depend on the pattern only.
-  // Fewer chunks on a small mesh (at least kMinRows rows each), where a chunk's fixed cost
-  // would show; still a function of the mesh alone.
-  const int rows = pattern.block_rows();
-  const int count = std::clamp(rows / kMinRows, 1, kMaxCount);
-  const long long blocks = pattern.row_start.back();
-  start.assign(count + 1, rows);
-  start[0] = 0;
-  int i = 0;
-  for (int c = 1; c < count; ++c) {
-    const long long target = blocks * c / count;
-    while (i < rows && pattern.row_start[i] < target) ++i;
-    start[c] = i;
-  }
-}
+RowChunks::RowChunks(const BlockSparseMatrix& pattern)
+    // Fewer chunks on a small mesh (at least kMinRows rows each), where a chunk's fixed cost
+    // would show; still a function of the mesh alone.
+    : start(equal_block_partition(pattern.row_start,
+                                  std::clamp(pattern.block_rows() / kMinRows, 1, kMaxCount))) {}
 
 double sum_in_order(const std::vector<double>& partial) {
   double sum = 0.0;

@@ -2,8 +2,8 @@
 // into a FIXED set of chunks (RowChunks); every parallel loop over rows shares out those
 // chunks, and every sum over the mesh is a sum of per-chunk sums added in chunk order, never
 // an OpenMP reduction (whose order of combination OpenMP leaves unspecified). So the solve
-// gives the same bits for any thread count. The preconditioner is a parameter: block
-// Jacobi here, chapter 10's V-cycle there. Chapter 10 includes this file.
+// gives the same bits for any thread count. The preconditioner is a parameter (block Jacobi
+// here): any Preconditioner that keeps the same rules.
 #pragma once
 
 #include <Eigen/Core>

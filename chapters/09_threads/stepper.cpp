@@ -78,15 +78,6 @@ std::array<PairOf, 16> pair_of_blocks() {
 }
 const std::array<PairOf, 16> kPairOf = pair_of_blocks();
 
-// total += mine, from every thread once. An integer sum is exact in any order, so the one
-// atomic of the chapter leaves the result independent of the threads. (Not an OpenMP
-// reduction: on an orphaned loop of a variable a lambda captures, Clang 14 refuses it,
-// "reduction variable must be shared", where GCC accepts it.)
-void add_count(long long& total, long long mine) {
-#pragma omp atomic
-  total += mine;
-}
-
 }  // namespace
 
 ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& settings,
@@ -108,9 +99,9 @@ void ThreadsStepper::step(State& state) {
   // The program's count is OpenMP's (--threads, OMP_NUM_THREADS); a step on another team sets
   // it for this thread's regions during the step and puts it back.
   const int given = max_threads();
-  // libgomp mallocs a thread's ICV block at its first omp_set_num_threads (gomp_icv in
-  // libgomp's icv.c; measured: one allocation, once): make it in the first step, which the
-  // zero-allocation rule leaves out, not in the first step that switches the team.
+  // libgomp mallocs a thread's ICV block at its first omp_set_num_threads, once (gomp_icv in
+  // libgomp's icv.c): make it in the first step, which the zero-allocation rule leaves out,
+  // not in the first step that switches the team.
   if (!steps_taken_++) set_threads(given);
   const int team = adaptive_team_.next(given);
   if (team != given) set_threads(team);

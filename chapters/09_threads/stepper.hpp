@@ -30,8 +30,8 @@ enum class ElementParallelism {
 };
 
 // Chapter 08's step with three of its phases on every thread: the system's start, the fused
-// element pass, and the solve (parallel_pcg.hpp). Chapter 10 derives from this stepper and
-// changes only the preconditioner.
+// element pass, and the solve (parallel_pcg.hpp). A derived stepper can change the
+// preconditioner alone (use_preconditioner).
 class ThreadsStepper : public ch08::ElementKernelsStepper {
  public:
   ThreadsStepper(const Scene& scene, const SolverSettings& settings,
@@ -51,13 +51,14 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // The PCG's preconditioner from the next step on (block Jacobi until then), and the
   // chapter's name in the solver's warnings. The preconditioner must outlive the stepper.
   void use_preconditioner(Preconditioner& preconditioner, const char* chapter);
-  // The parallel PCG on the filtered system from the guess in y_ (chapter 10 extends it).
+  // The parallel PCG on the filtered system from the guess in y_ (virtual: a derived stepper
+  // may prepare its preconditioner first).
   void solve() override;
-  // Colours groups of `group` consecutive elements (kGroup by default); chapter 11, whose
-  // elements come sorted along the mesh, makes the groups long slabs.
+  // Colours groups of `group` consecutive elements (kGroup by default): on a mesh whose
+  // elements come sorted along it, long groups are slabs, and fewer colours.
   void colour_element_groups(int group);
-  // The colouring, for a chapter that computes a group's elements its own way (chapter 12:
-  // several at a time): colour c is the groups colour_order()[k] for k in [colour_start()[c],
+  // The colouring, for a stepper that computes a group's elements its own way (several at a
+  // time, say): colour c is the groups colour_order()[k] for k in [colour_start()[c],
   // colour_start()[c + 1]), group g the elements [g * group_size(), (g + 1) * group_size()).
   const std::vector<int>& colour_order() const { return colour_order_; }
   const std::vector<int>& colour_start() const { return colour_start_; }

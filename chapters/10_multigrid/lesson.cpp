@@ -23,6 +23,7 @@
 
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/threads.hpp"
 
@@ -31,48 +32,6 @@ namespace fem::ch10 {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-MultigridSettings::Smoother smoother_from(const std::string& name) {
-  if (name == "gs") return MultigridSettings::Smoother::GaussSeidel;
-  if (name == "chebyshev") return MultigridSettings::Smoother::Chebyshev;
-  if (name == "jacobi") return MultigridSettings::Smoother::Jacobi;
-  throw UsageError("--smoother must be gs, chebyshev or jacobi");
-}
-
-MultigridSettings multigrid_from_args(const ArgParser& args) {
-  MultigridSettings s;
-  s.modes = args.get_int("modes");
-  s.smoother = smoother_from(args.get("smoother"));
-  s.sweeps = args.get_int("sweeps");
-  s.l1 = args.get("l1") != "off";
-  s.extrapolation = args.get_int("extrapolate");
-  if (s.extrapolation < 0 || s.extrapolation > 2)
-    throw UsageError("--extrapolate must be 0, 1 or 2");
-  s.max_blocks = args.get_int("blocks");
-  s.serial_rows = args.get_int("serial-rows");
-  s.chebyshev_degree = args.get_int("degree");
-  s.improve_candidates = args.get_int("improve");
-  s.power_iterations = args.get_int("power");
-  if (s.power_iterations < 1) throw UsageError("--power must be at least 1");
-  const std::string prolongator = args.get("prolongator");
-  if (prolongator != "every-step" && prolongator != "frozen" && prolongator != "tentative")
-    throw UsageError("--prolongator must be frozen, every-step or tentative");
-  s.smooth_prolongator = prolongator != "tentative";
-  s.update_prolongator = prolongator == "every-step";
-  s.max_coarse_dofs = args.get_int("max-coarse");
-  s.coarse_refresh = args.get_int("coarse-every");
-  s.refresh_growth = args.get_double("growth");
-  if (s.coarse_refresh < 1) throw UsageError("--coarse-every must be at least 1");
-  if (s.modes != 3 && s.modes != 6) throw UsageError("--modes must be 3 or 6");
-  if (s.sweeps < 1) throw UsageError("--sweeps must be at least 1");
-  if (s.max_coarse_dofs < 6) throw UsageError("--max-coarse must be at least 6");
-  if (s.max_blocks < 1 || s.chebyshev_degree < 1 || s.improve_candidates < 0 || s.serial_rows < 0)
-    throw UsageError(
-        "--blocks and --degree must be at least 1, --improve and --serial-rows 0 or more");
-  if (!(s.refresh_growth >= 0.0)) throw UsageError("--growth must be 0 (off) or more");
-  if (args.get("l1") != "on" && args.get("l1") != "off") throw UsageError("--l1 must be on or off");
-  return s;
-}
 
 // The filtered rigid-body modes at the rest positions, 3N x 6: PyAMG's B.
 Eigen::MatrixXd rigid_body_modes(const Scene& scene) {
@@ -110,7 +69,7 @@ RunStats run_chapter(MultigridStepper& stepper, const Scene& scene, int steps) {
     if ((k + 1) % std::max(1, steps / 4) == 0)
       std::cerr << "  step " << k + 1 << "/" << steps << "\n" << std::flush;
   }
-  out.refreshes = stepper.multigrid().refreshes();
+  out.refreshes = stepper.multigrid().refresh_rule().refreshes();
   return out;
 }
 
@@ -152,8 +111,8 @@ Costs measure_costs(Multigrid& mg, const Eigen::VectorXd& b, int threads, long l
   Eigen::VectorXd y(b.size());
   for (int l = 0; l < mg.levels(); ++l) {
     LevelCost cost;  // between refreshes prepare() touches the finest level only
-    if (l == 0) cost.between = team_ms(5, [&] { mg.prepare_level_only(l, false); });
-    cost.refresh = team_ms(5, [&] { mg.prepare_level_only(l, true); });
+    if (l == 0) cost.between = team_ms(5, [&] { mg.factorize_level(l, false); });
+    cost.refresh = team_ms(5, [&] { mg.factorize_level(l, true); });
     cost.cycle_from = team_ms(20, [&] { mg.cycle_from(l); });
     c.level.push_back(cost);
   }
@@ -186,8 +145,8 @@ std::string cost_table(const Multigrid& mg, const std::vector<Costs>& costs, dou
     t << "\n";
   };
   for (int l = 0; l < mg.levels(); ++l) {
-    const std::string level =
-        "level " + std::to_string(l) + " (" + std::to_string(mg.level_parts(l)) + " row blocks): ";
+    const std::string level = "level " + std::to_string(l) + " (" +
+                              std::to_string(level_row_blocks(mg, l)) + " row blocks): ";
     if (l == 0)
       row(level + "`prepare` between refreshes",
           [&](const Costs& c) { return ms_spmv(c.level[l].between, spmv); });
@@ -208,21 +167,6 @@ std::string cost_table(const Multigrid& mg, const std::vector<Costs>& costs, dou
     return s.str();
   });
   return t.str();
-}
-
-std::vector<int> cost_thread_counts(const ArgParser& args) {
-  std::vector<int> out;
-  std::stringstream list(args.get("cost-threads"));
-  for (std::string item; std::getline(list, item, ',');) {
-    const int n = std::atoi(item.c_str());
-    if (n < 1 || std::to_string(n) != item)
-      throw UsageError("--cost-threads expects thread counts >= 1 separated by commas");
-    if (n > 1 && !openmp_enabled()) throw UsageError("--cost-threads: this build has no OpenMP");
-    out.push_back(n);
-  }
-  if (out.empty()) out = {1, max_threads()};
-  if (out.size() == 2 && out[0] == out[1]) out.pop_back();
-  return out;
 }
 
 // PCG from zero on the last system: the V-cycle, block Jacobi, Eigen's IncompleteCholesky.
@@ -290,14 +234,14 @@ void print_hierarchy(const Multigrid& mg, double setup_ms) {
   long long blocks = 0, fine_blocks = 0;
   for (int l = 0; l < mg.levels(); ++l) {
     const int block = l == 0 ? 3 : 6;
-    std::cerr << "  level " << l << ": " << std::setw(7) << mg.level_dofs(l) << " unknowns, "
-              << std::setw(8) << mg.level_blocks(l) << " blocks of " << block << "x" << block
-              << ", " << mg.level_parts(l) << " row blocks";
+    std::cerr << "  level " << l << ": " << std::setw(7) << level_dofs(mg, l) << " unknowns, "
+              << std::setw(8) << level_blocks(mg, l) << " blocks of " << block << "x" << block
+              << ", " << level_row_blocks(mg, l) << " row blocks";
     if (l + 1 < mg.levels())
-      std::cerr << ", P " << std::setw(7) << mg.prolongator_blocks(l) << " blocks of " << block
+      std::cerr << ", P " << std::setw(7) << prolongator_blocks(mg, l) << " blocks of " << block
                 << "x6";
     std::cerr << "\n";
-    blocks += mg.level_blocks(l) * block * block;
+    blocks += level_blocks(mg, l) * block * block;
     if (l == 0) fine_blocks = blocks;
   }
   std::cerr << "  operator complexity (stored entries, all levels / finest): "
@@ -312,8 +256,8 @@ std::string main_table(const LessonRun& run, const Multigrid& mg, const RunStats
     << max_threads() << " thread(s) | value |\n"
     << "| --- | ---: |\n";
   for (int l = 0; l < mg.levels(); ++l)
-    t << "| level " << l << ": unknowns (stored blocks) | " << mg.level_dofs(l) << " ("
-      << mg.level_blocks(l) << ") |\n";
+    t << "| level " << l << ": unknowns (stored blocks) | " << level_dofs(mg, l) << " ("
+      << level_blocks(mg, l) << ") |\n";
   const double prepare = costs.front().prepare_per_step;
   t << "| median PCG iterations per step (warm start) | " << median(stats.iterations) << " |\n"
     << "| median solve / step, ms (wall) | " << std::setprecision(2) << median(stats.solve_ms)
@@ -334,7 +278,7 @@ std::string multigrid_table(const LessonRun& run) {
   const ArgParser& args = run.args;
   const Scene& scene = run.scene;
   const SolverSettings solver = solver_from_args(args);
-  const MultigridSettings settings = multigrid_from_args(args);
+  const MultigridStepperSettings settings = multigrid_from_args(args);
   const std::vector<int> counts = cost_thread_counts(args);
   std::cerr << "fem_lessons multigrid: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes), " << run.steps << " steps, tol "
@@ -370,65 +314,6 @@ std::string multigrid_table(const LessonRun& run) {
   if (!z.v_cycle.converged)
     throw std::runtime_error("the V-cycle PCG did not converge on the last system");
   return t.str();
-}
-
-const char* smoother_name(MultigridSettings::Smoother smoother) {
-  switch (smoother) {
-    case MultigridSettings::Smoother::GaussSeidel:
-      return "gs";
-    case MultigridSettings::Smoother::Chebyshev:
-      return "chebyshev";
-    default:
-      return "jacobi";
-  }
-}
-
-// The options' defaults are the chapter's (MultigridSettings{}).
-void add_multigrid_options(ArgParser& args) {
-  const MultigridSettings d;
-  const auto text = [](auto value) {
-    std::ostringstream s;
-    s << value;
-    return s.str();
-  };
-  add_solver_options(args);
-  args.option("modes", "N", "near-null-space modes per aggregate: 6 or 3 (translations)",
-              text(d.modes));
-  args.option("smoother", "NAME",
-              "gs (l1-hybrid block Gauss-Seidel), chebyshev (on block Jacobi) or jacobi",
-              smoother_name(d.smoother));
-  args.option("sweeps", "N", "pre- and post-smoothing sweeps", text(d.sweeps));
-  args.option("l1", "on|off", "Gauss-Seidel: the l1 term on the couplings between row blocks",
-              d.l1 ? "on" : "off");
-  args.option("blocks", "N", "at most N fixed row blocks per level (1: sequential Gauss-Seidel)",
-              text(d.max_blocks));
-  args.option("serial-rows", "N", "levels of fewer rows run on one thread", text(d.serial_rows));
-  args.option("degree", "N", "Chebyshev: the polynomial's degree", text(d.chebyshev_degree));
-  args.option("power", "N", "power iterations of the first estimate of rho(D^-1 A) on each level",
-              text(d.power_iterations));
-  args.option("improve", "N", "symmetric Gauss-Seidel sweeps on the rigid-body modes at set-up",
-              text(d.improve_candidates));
-  args.option("extrapolate", "ORDER",
-              "the guess: 0 the last solution, 1 the line through the last two, 2 the parabola "
-              "through the last three",
-              text(d.extrapolation));
-  args.option("prolongator", "KIND",
-              "frozen (smoothed on the first step), every-step (smoothed at every refresh) or "
-              "tentative (unsmoothed)",
-              d.update_prolongator   ? "every-step"
-              : d.smooth_prolongator ? "frozen"
-                                     : "tentative");
-  args.option("max-coarse", "N", "largest level solved by dense Cholesky, in unknowns",
-              text(d.max_coarse_dofs));
-  args.option("coarse-every", "K", "recompute the coarse matrices every K-th step",
-              text(d.coarse_refresh));
-  args.option("growth", "G",
-              "and earlier when a solve takes more than G times the V-cycles after the last "
-              "refresh (0: never)",
-              text(d.refresh_growth));
-  args.option("export", "DIR", "write the last filtered system as Matrix Market into DIR", "");
-  args.option("cost-threads", "LIST",
-              "thread counts of the cost table, comma-separated (default: 1 and --threads)", "");
 }
 
 }  // namespace

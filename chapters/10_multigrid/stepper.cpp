@@ -1,7 +1,7 @@
 // Chapter 10: chapter 09's step, A dv = b filtered by PPCG and solved by the parallel PCG,
 // with two changes: the preconditioner, and the guess. Block Jacobi becomes one V-cycle of
-// smoothed-aggregation multigrid, set up once from the mesh (the constructor), its finest
-// level refreshed every solve and its coarse levels every few (prepare), applied once per
+// smoothed-aggregation multigrid, set up once from the mesh (analyze_pattern), its finest
+// level refreshed every solve and its coarse levels every few (factorize), applied once per
 // PCG iteration (apply); the guess is the polynomial through the last solutions.
 #include "chapters/10_multigrid/stepper.hpp"
 
@@ -21,7 +21,7 @@ Eigen::VectorXd rest_positions(const Scene& scene) {
 
 void VCyclePreconditioner::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
   // Every thread of the solve's team: the multigrid shares out its own row blocks.
-  multigrid_.prepare(A.blocks);
+  multigrid_.factorize(A.blocks);
 }
 
 void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
@@ -33,15 +33,16 @@ void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& 
 }
 
 MultigridStepper::MultigridStepper(const Scene& scene, const SolverSettings& settings,
-                                   const MultigridSettings& multigrid,
+                                   const MultigridStepperSettings& multigrid,
                                    ch09::ElementParallelism element_parallelism)
     : ThreadsStepper(scene, settings, element_parallelism),
-      // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
-      multigrid_(system_matrix().row_start, system_matrix().column, rest_positions(scene),
-                 scene.constraints, multigrid),
+      multigrid_(multigrid.multigrid),
       extrapolation_(multigrid.extrapolation) {
   if (extrapolation_ < 0 || extrapolation_ > 2)
     throw std::invalid_argument("multigrid stepper: the guess's extrapolation order is 0, 1 or 2");
+  // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
+  multigrid_.analyze_pattern(system_matrix().row_start, system_matrix().column,
+                             rest_positions(scene), scene.constraints);
   for (auto& h : history_) h = Eigen::VectorXd::Zero(3 * scene.mesh.num_nodes());
   use_preconditioner(v_cycle_, "10_multigrid");
 }

@@ -13,8 +13,17 @@
 
 namespace fem::ch10 {
 
+// The stepper's settings: the hierarchy's, and the PCG's guess.
+struct MultigridStepperSettings {
+  MultigridSettings multigrid;
+  // The guess: the polynomial through the last extrapolation + 1 solutions one step ahead
+  // (0: the last solution, chapter 09's warm start; 1: 2 y_n - y_(n-1); 2: 3 y_n - 3 y_(n-1)
+  // + y_(n-2)).
+  int extrapolation = 2;
+};
+
 // One V-cycle of the hierarchy as the preconditioner of chapter 09's PCG: prepare() gives
-// the hierarchy this solve's matrix, apply() runs one cycle from a zero guess.
+// the hierarchy this solve's matrix (factorize), apply() runs one cycle from a zero guess.
 class VCyclePreconditioner final : public ch09::Preconditioner {
  public:
   explicit VCyclePreconditioner(Multigrid& multigrid) : multigrid_(multigrid) {}
@@ -26,11 +35,12 @@ class VCyclePreconditioner final : public ch09::Preconditioner {
   Multigrid& multigrid_;
 };
 
-// Not final: chapter 11 runs this step on a renumbered mesh.
+// Not final: a derived stepper may run this step on other data (a renumbered mesh).
 class MultigridStepper : public ch09::ThreadsStepper {
  public:
   MultigridStepper(
-      const Scene& scene, const SolverSettings& settings, const MultigridSettings& multigrid = {},
+      const Scene& scene, const SolverSettings& settings,
+      const MultigridStepperSettings& multigrid = {},
       ch09::ElementParallelism element_parallelism = ch09::ElementParallelism::colouring);
 
   const Multigrid& multigrid() const { return multigrid_; }
@@ -40,7 +50,7 @@ class MultigridStepper : public ch09::ThreadsStepper {
   // Chapter 09's solve from a guess extrapolated from the last solutions.
   void solve() override;
 
-  Multigrid multigrid_;  // set up from the pattern of the system matrix
+  Multigrid multigrid_;  // its pattern analysed from the system matrix's
   VCyclePreconditioner v_cycle_{multigrid_};
   int extrapolation_;           // the guess's order: 0, 1 or 2
   Eigen::VectorXd history_[2];  // the solutions of the two steps before the last

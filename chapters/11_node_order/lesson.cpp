@@ -49,12 +49,6 @@ std::vector<Run> runs_for(const LessonRun& run) {
   return runs;
 }
 
-std::string fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
-
 // One row: the order's measures of memory distance, and its times (1 thread, medians).
 std::string row(Run& r) {
   const OrderQuality q = order_quality(renumbered(r.scene, r.stepper->order(), false).mesh);
@@ -112,14 +106,7 @@ std::string one_mesh_table(const LessonRun& run) {
 
 // The scene's mesh, then each of --meshes (the same scene and material on it): one table each.
 std::string node_order_table(const LessonRun& run) {
-  std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
-  std::stringstream list(run.args.get("meshes"));
-  for (std::string path; std::getline(list, path, ',');) {
-    if (path.empty()) continue;
-    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
-    scenes.back().dt = run.scene.dt;
-    scenes.back().damping = run.scene.damping;
-  }
+  const std::vector<Scene> scenes = more_meshes(run);
   std::string tables = one_mesh_table(run);
   for (const Scene& scene : scenes)
     tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});

@@ -6,14 +6,15 @@
 namespace fem::ch11 {
 
 NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
-                                   Ordering ordering, const ch10::MultigridSettings& multigrid)
+                                   Ordering ordering,
+                                   const ch10::MultigridStepperSettings& multigrid)
     : NodeOrderStepper(scene, settings, ordering, node_order(scene.mesh, ordering), multigrid) {}
 
 // The order is computed once by the public constructor and passed here, so that chapter 10's
 // stepper is built on the renumbered scene before this class's members exist.
 NodeOrderStepper::NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
                                    Ordering ordering, NodeOrder order,
-                                   const ch10::MultigridSettings& multigrid)
+                                   const ch10::MultigridStepperSettings& multigrid)
     : MultigridStepper(renumbered(scene, order, ordering != Ordering::original), settings,
                        multigrid),
       ordering_(ordering),

@@ -15,7 +15,7 @@ class NodeOrderStepper : public ch10::MultigridStepper {
  public:
   NodeOrderStepper(const Scene& scene, const SolverSettings& settings,
                    Ordering ordering = Ordering::rcm,
-                   const ch10::MultigridSettings& multigrid = {});
+                   const ch10::MultigridStepperSettings& multigrid = {});
 
   // The caller's state in the mesh's numbering, in and out; chapter 10's step in between.
   void step(State& state) override;
@@ -28,7 +28,7 @@ class NodeOrderStepper : public ch10::MultigridStepper {
 
  private:
   NodeOrderStepper(const Scene& scene, const SolverSettings& settings, Ordering ordering,
-                   NodeOrder order, const ch10::MultigridSettings& multigrid);
+                   NodeOrder order, const ch10::MultigridStepperSettings& multigrid);
 
   static constexpr int kSlabs = 64;  // element groups of the parallel pass (stepper.cpp)
   Ordering ordering_;

@@ -16,17 +16,10 @@
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
 #include "chapters/08_element_kernels/element_kernels.hpp"
+#include "chapters/12_half_the_bytes/batch_rotations.hpp"
 #include "common/model.hpp"
 
 namespace fem::ch12 {
-
-// Elements per batch: 8 doubles fill an AVX-512 register, two AVX2 ones.
-constexpr int kLanes = 8;
-
-// One number per lane, aligned to a cache line.
-struct alignas(64) Lanes {
-  double v[kLanes];
-};
 
 // What a batch of elements adds to the system, lane by lane: the terms of b (rhs[i][a]: row i,
 // corner a) and the ten distinct blocks K[p][i][j] in ch08::kUpperPairs order.
@@ -34,6 +27,8 @@ struct BatchTerms {
   Lanes rhs[3][4];
   Lanes K[10][3][3];
 };
+
+struct GatheredBatch;  // a batch's numbers while terms() runs (element_batch.cpp)
 
 // The element loop's state, as ch08::FusedElements's, across elements: the shapes and the last
 // two steps' rotations, one array per component.
@@ -55,6 +50,10 @@ class BatchedElements {
   long long last_step_fallbacks() const { return last_step_fallbacks_; }
 
  private:
+  void gather(int first, int count, const std::vector<Eigen::Vector4i>& tets, const State& state,
+              GatheredBatch& g) const;
+  void keep_rotations(int first, int count, const GatheredBatch& g, const Lanes (&q)[4]);
+
   int elements_ = 0;
   double h_ = 0.0, velocity_scale_ = 0.0, stiffness_ = 0.0;
   // Per element: Dm^-1 by entries (dm[3 * i + j]), V mu, V lambda, and the quaternions of the

@@ -2,6 +2,7 @@
 #include "chapters/12_half_the_bytes/lesson.hpp"
 
 #include <algorithm>
+#include <array>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "chapters/08_element_kernels/element_kernels.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/11_node_order/node_order.hpp"
 #include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/element_batch.hpp"
@@ -21,20 +23,14 @@ namespace fem::ch12 {
 
 namespace {
 
-std::string fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
-
 // Chapter 10's hierarchy in double: every level's blocks and inverse diagonals, P and P^T
 // (the coarsest level is a dense Cholesky factor, the same in both chapters: not counted).
 double double_megabytes(const ch10::Multigrid& mg) {
   long long bytes = 0;
   for (int l = 0; l + 1 < mg.levels(); ++l) {
     const long long b = l == 0 ? 3 : ch10::kModes;
-    bytes += 8 * b * b * (mg.level_blocks(l) + mg.level_dofs(l) / b);
-    bytes += 2 * 8 * b * ch10::kModes * mg.prolongator_blocks(l);
+    bytes += 8 * b * b * (ch10::level_blocks(mg, l) + ch10::level_dofs(mg, l) / b);
+    bytes += 2 * 8 * b * ch10::kModes * ch10::prolongator_blocks(mg, l);
   }
   return 1e-6 * static_cast<double>(bytes);
 }
@@ -141,101 +137,103 @@ std::string half_the_bytes_table(const LessonRun& run) {
                                   "'");
     tight.push_back(value);
   }
-  std::vector<Scene> scenes;  // all loaded before any is measured: a bad path fails at once
-  std::stringstream list(run.args.get("meshes"));
-  for (std::string path; std::getline(list, path, ',');) {
-    if (path.empty()) continue;
-    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
-    scenes.back().dt = run.scene.dt;
-    scenes.back().damping = run.scene.damping;
-  }
+  const std::vector<Scene> scenes = more_meshes(run);
   std::string tables = one_mesh_table(run, tight);
   for (const Scene& scene : scenes)
     tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter}, tight);
   return tables;
 }
 
+// The four element passes of the table, each with its own elements' state, so that each
+// step's rotations start from the last two steps' (and the system they scatter into).
+struct ElementPasses {
+  ElementPasses(const Model& model, const Scene& scene)
+      : model(model),
+        one(model, scene),
+        one_pass(model, scene),
+        batched(model, scene),
+        batched_pass(model, scene),
+        A(node_adjacency(scene.mesh)),
+        index(A, model.tets),
+        b(Eigen::VectorXd::Zero(model.dofs)) {}
+
+  // ms of each pass over the whole mesh on this state: the terms one at a time, kLanes at a
+  // time, and each with its scatter (braces: evaluated in this order).
+  std::array<double, 4> time(const State& state) {
+    return {one_ms(one, state, false), batched_ms(batched, state, false),
+            one_ms(one_pass, state, true), batched_ms(batched_pass, state, true)};
+  }
+  double one_ms(ch08::FusedElements& elements, const State& state, bool scatter) {
+    long long fallbacks = 0;
+    const double ms = time_ms(1, [&] {
+      for (int e = 0; e < static_cast<int>(model.tets.size()); ++e) {
+        elements.terms(e, model.tets[e], state, fallbacks, terms);
+        if (scatter) ch08::scatter(model.tets[e], index.element[e], terms, A, b);
+      }
+    });
+    elements.end_pass(fallbacks);
+    return ms;
+  }
+  double batched_ms(BatchedElements& elements, const State& state, bool scatter) {
+    const int n = static_cast<int>(model.tets.size());
+    long long fallbacks = 0;
+    const double ms = time_ms(1, [&] {
+      for (int e = 0; e < n; e += kLanes) {
+        const int count = std::min(kLanes, n - e);
+        elements.terms(e, count, model.tets, state, fallbacks, batch);
+        for (int l = 0; scatter && l < count; ++l)
+          ch12::scatter(batch, l, model.tets[e + l], index.element[e + l], A, b);
+      }
+    });
+    elements.end_pass(fallbacks);
+    return ms;
+  }
+
+  const Model& model;
+  ch08::FusedElements one, one_pass;
+  BatchedElements batched, batched_pass;
+  ch08::ElementTerms terms;
+  BatchTerms batch;
+  ch07::BlockSparseMatrix A;
+  const ch07::BlockIndex index;
+  Eigen::VectorXd b;
+};
+
 // The element terms of every element, one at a time (chapter 08's FusedElements::terms) and
 // kLanes at a time (BatchedElements::terms), alone and with their scatter into A and b (the
 // whole element pass, serial): ns per element, 1 thread. On the mesh in the order chapter 12
 // steps it (chapter 11's: nodes by reverse Cuthill-McKee, elements sorted along them), and
-// on the states of chapter 12 stepping it, so the rotations turn as in a run. Each pass has
-// its own elements' state, so that each step's rotations start from the last two steps'.
+// on the states of chapter 12 stepping it, so the rotations turn as in a run.
 std::string one_mesh_elements(const LessonRun& run) {
   const Scene scene =
       ch11::renumbered(run.scene, ch11::node_order(run.scene.mesh, ch11::Ordering::rcm));
   HalfBytesStepper stepper(scene, SolverSettings{});
   const Model model(scene);
-  ch08::FusedElements one(model, scene), one_pass(model, scene);
-  BatchedElements batched(model, scene), batched_pass(model, scene);
-  const int n = static_cast<int>(model.tets.size());
+  ElementPasses passes(model, scene);
+  const double n = static_cast<double>(model.tets.size());
   State state = rest_state(scene);
-  std::vector<double> one_ns, batched_ns, one_pass_ns, batched_pass_ns;
-  ch08::ElementTerms terms;
-  BatchTerms batch;
-  ch07::BlockSparseMatrix A(node_adjacency(scene.mesh));
-  const ch07::BlockIndex index(A, model.tets);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(model.dofs);
+  std::vector<double> ns[4];
   for (int k = 0; k < run.steps + 2; ++k) {
     if (k % 10 == 0)
       progress("batched-elements: step " + std::to_string(k + 1) + " of " +
                std::to_string(run.steps + 2));
     stepper.step(state);
-    long long f1 = 0, f2 = 0;
-    const double t1 = time_ms(1, [&] {
-      for (int e = 0; e < n; ++e) {
-        one.terms(e, model.tets[e], state, f1, terms);
-      }
-    });
-    const double t2 = time_ms(1, [&] {
-      for (int e = 0; e < n; e += kLanes) {
-        batched.terms(e, std::min(kLanes, n - e), model.tets, state, f2, batch);
-      }
-    });
-    one.end_pass(f1);
-    batched.end_pass(f2);
-    long long f3 = 0, f4 = 0;
-    const double t3 = time_ms(1, [&] {
-      for (int e = 0; e < n; ++e) {
-        one_pass.terms(e, model.tets[e], state, f3, terms);
-        ch08::scatter(model.tets[e], index.element[e], terms, A, b);
-      }
-    });
-    const double t4 = time_ms(1, [&] {
-      for (int e = 0; e < n; e += kLanes) {
-        const int count = std::min(kLanes, n - e);
-        batched_pass.terms(e, count, model.tets, state, f4, batch);
-        for (int l = 0; l < count; ++l)
-          scatter(batch, l, model.tets[e + l], index.element[e + l], A, b);
-      }
-    });
-    one_pass.end_pass(f3);
-    batched_pass.end_pass(f4);
+    const std::array<double, 4> ms = passes.time(state);
     if (k < 2) continue;
-    one_ns.push_back(1e6 * t1 / n);
-    batched_ns.push_back(1e6 * t2 / n);
-    one_pass_ns.push_back(1e6 * t3 / n);
-    batched_pass_ns.push_back(1e6 * t4 / n);
+    for (int p = 0; p < 4; ++p) ns[p].push_back(1e6 * ms[p] / n);
   }
-  const double one_terms = median(one_ns), batched_terms = median(batched_ns);
-  const double one_all = median(one_pass_ns), batched_all = median(batched_pass_ns);
+  const double one_terms = median(ns[0]), batched_terms = median(ns[1]);
+  const double one_all = median(ns[2]), batched_all = median(ns[3]);
   std::ostringstream out;
-  out << "| `" << mesh_name(scene) << "` | " << n << " | " << fixed(one_terms, 1) << " | "
-      << fixed(batched_terms, 1) << " | x" << fixed(one_terms / batched_terms, 2) << " | "
+  out << "| `" << mesh_name(scene) << "` | " << model.tets.size() << " | " << fixed(one_terms, 1)
+      << " | " << fixed(batched_terms, 1) << " | x" << fixed(one_terms / batched_terms, 2) << " | "
       << fixed(one_all, 1) << " | " << fixed(batched_all, 1) << " | x"
       << fixed(one_all / batched_all, 2) << " |\n";
   return out.str();
 }
 
 std::string batched_elements_table(const LessonRun& run) {
-  std::vector<Scene> scenes;
-  std::stringstream list(run.args.get("meshes"));
-  for (std::string path; std::getline(list, path, ',');) {
-    if (path.empty()) continue;
-    scenes.push_back(make_scene(run.scene.name, load_mesh(path), run.scene.material));
-    scenes.back().dt = run.scene.dt;
-    scenes.back().damping = run.scene.damping;
-  }
+  const std::vector<Scene> scenes = more_meshes(run);
   const std::string lanes = std::to_string(kLanes);
   std::string table =
       "| mesh | elements | terms: one at a time (chapter 08), ns per element | terms: " + lanes +

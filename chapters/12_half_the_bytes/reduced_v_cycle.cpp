@@ -1,41 +1,19 @@
-// Chapter 12: chapter 10's V-cycle on float numbers (see reduced_v_cycle.hpp). The loops are
-// chapter 10's (multigrid.cpp: polynomial_step, residual, restrict_rows, prolong_rows, cycle)
-// with the blocks read as float; only the polynomial smoothers are here, the ones whose every
-// sweep reads the whole level (Gauss-Seidel would be the same change once more).
+// Chapter 12: the kernels of chapter 10's V-cycle (v_cycle.hpp) on float levels, and the
+// conversion of chapter 10's numbers into them (see reduced_v_cycle.hpp). Only the polynomial
+// smoothers are here, the ones whose every sweep reads the whole level (Gauss-Seidel would be
+// the same change once more).
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
 
-#include <limits>
 #include <stdexcept>
 #include <type_traits>
 
 #include "chapters/09_threads/parallel.hpp"
+#include "chapters/10_multigrid/v_cycle.hpp"
 
 namespace fem::ch12 {
 
-namespace {
-
-// body(first, last) on each of the source level's fixed row blocks, shared out by the team
-// (chapter 10's for_parts): the same partition, so the same bits for any thread count.
-template <class Level, class Body>
-void for_parts(const Level& level, bool collective, Body&& body) {
-  const std::vector<int>& part = level.source->part;
-  const int count = static_cast<int>(part.size()) - 1;
-  if (collective) {
-    for (const int p : ch09::StaticShare(count)) body(part[p], part[p + 1]);
-  } else {
-    for (int p = 0; p < count; ++p) body(part[p], part[p + 1]);
-  }
-}
-
-template <class Body>
-void on_one_thread(bool collective, Body&& body) {
-  if (collective) {
-#pragma omp single
-    body();
-  } else {
-    body();
-  }
-}
+// Found by chapter 10's V-cycle through its level argument (argument-dependent lookup): so
+// in this namespace, not an unnamed one.
 
 // The products of the V-cycle, on float blocks, in padded lanes. Eigen keeps a fixed-size
 // vector whose length is no multiple of a packet in scalars (Matrix<float, 3, 1>: three
@@ -109,19 +87,25 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> times_inverse_diagonal(
   return out.total();
 }
 
-// Chapter 10's polynomial_step: d = alpha d + beta D^-1 (b - A in), out = in + d.
 template <class Real, int B>
-void polynomial_step(ReducedLevel<Real, B>& level, int k, int first, int last,
-                     const Eigen::Matrix<Real, Eigen::Dynamic, 1>& b,
-                     const Eigen::Matrix<Real, Eigen::Dynamic, 1>* in,
-                     Eigen::Matrix<Real, Eigen::Dynamic, 1>& out) {
+int smoothing_steps(const ReducedLevel<Real, B>& level) {
+  return static_cast<int>(level.weights.size()) / 2;
+}
+
+// Chapter 10's polynomial_step: d = alpha d + beta D^-1 (b - A in), out = in + d (its own
+// adjoint: the same step before and after the coarse correction).
+template <class Real, int B>
+void smooth(ReducedLevel<Real, B>& level, int k, int first, int last,
+            const Eigen::Matrix<Real, Eigen::Dynamic, 1>& b,
+            const Eigen::Matrix<Real, Eigen::Dynamic, 1>* in,
+            Eigen::Matrix<Real, Eigen::Dynamic, 1>& out, bool /*forward*/) {
   using Vector = Eigen::Matrix<Real, B, 1>;
-  const Real alpha = level.chebyshev[2 * k], beta = level.chebyshev[2 * k + 1];
+  const Real alpha = level.weights[2 * k], beta = level.weights[2 * k + 1];
   const std::vector<int>& row_start = level.source->A.row_start;
   for (int i = first; i < last; ++i) {
     Vector r = b.template segment<B>(B * i);
     if (in) r -= row_product(level, in->data(), row_start[i], row_start[i + 1]);
-    auto d = level.direction.template segment<B>(B * i);
+    auto d = level.vectors.direction.template segment<B>(B * i);
     if (k == 0 || !in)
       d = beta * times_inverse_diagonal(level, i, r);
     else
@@ -139,20 +123,20 @@ void residual(ReducedLevel<Real, B>& level, int first, int last,
               const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
   const std::vector<int>& row_start = level.source->A.row_start;
   for (int i = first; i < last; ++i)
-    level.work.template segment<B>(B * i) =
+    level.vectors.residual.template segment<B>(B * i) =
         b.template segment<B>(B * i) - row_product(level, x.data(), row_start[i], row_start[i + 1]);
 }
 
-// b_c = P^T r on coarse rows [first, last), fine rows in increasing order.
+// b_c = R r on coarse rows [first, last), fine rows in increasing order.
 template <class Real, int B>
 void restrict_rows(const ReducedLevel<Real, B>& level, ReducedLevel<Real, kModes>& coarse,
                    int first, int last) {
-  const auto& PT = level.source->PT;
+  const auto& R = level.source->transfer.R;
   for (int c = first; c < last; ++c) {
     auto sum = Sums<Real, kModes, B>::Zero();
-    for (int e = PT.row_start[c]; e < PT.row_start[c + 1]; ++e)
-      add_product(sum, level.PT[e], level.work.data() + B * PT.column[e]);
-    coarse.b.template segment<kModes>(kModes * c) = sum.total();
+    for (int e = R.row_start[c]; e < R.row_start[c + 1]; ++e)
+      add_product(sum, level.R[e], level.vectors.residual.data() + B * R.column[e]);
+    coarse.vectors.b.template segment<kModes>(kModes * c) = sum.total();
   }
 }
 
@@ -160,42 +144,52 @@ void restrict_rows(const ReducedLevel<Real, B>& level, ReducedLevel<Real, kModes
 template <class Real, int B>
 void prolong_rows(ReducedLevel<Real, B>& level, const ReducedLevel<Real, kModes>& coarse, int first,
                   int last, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
-  const auto& P = level.source->P;
+  const auto& P = level.source->transfer.P;
   for (int i = first; i < last; ++i) {
     auto sum = Sums<Real, B, kModes>::Zero();
     for (int m = P.row_start[i]; m < P.row_start[i + 1]; ++m)
-      add_product(sum, level.P[m], coarse.x.data() + kModes * P.column[m]);
-    level.y.template segment<B>(B * i) = x.template segment<B>(B * i) + sum.total();
+      add_product(sum, level.P[m], coarse.vectors.x.data() + kModes * P.column[m]);
+    level.vectors.y.template segment<B>(B * i) = x.template segment<B>(B * i) + sum.total();
   }
 }
+
+// At most max_coarse_dofs unknowns: the dense solve stays in double, in chapter 10's factor.
+template <class Real, int B>
+void solve_coarsest(ReducedLevel<Real, B>& level, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& b,
+                    Eigen::Matrix<Real, Eigen::Dynamic, 1>& out) {
+  level.dense = b.template cast<double>();
+  ch10::solve_in_place(level.source->coarsest_solve, level.dense);
+  out = level.dense.template cast<Real>();
+}
+
+namespace {
 
 template <class Real, int B>
 void size_level(ReducedLevel<Real, B>& level, const ch10::Level<B>& source) {
   level.source = &source;
-  const Eigen::Index n = source.dofs();
-  for (auto* v : {&level.b, &level.x, &level.y, &level.work, &level.direction}) v->setZero(n);
+  level.vectors.resize(source.dofs());
   if (source.coarsest) {  // chapter 10's Cholesky factor in double, nothing in float
-    level.dense.setZero(n);
+    level.dense.setZero(source.dofs());
     return;
   }
   // One padding block after each array (add_product reads a few floats past a block's end).
   level.blocks.resize(source.A.column.size() + 1, Eigen::Matrix<float, B, B>::Zero());
   level.inverse_diagonal.resize(source.nodes() + 1, Eigen::Matrix<float, B, B>::Zero());
-  level.P.resize(source.P.blocks.size() + 1, Eigen::Matrix<float, B, kModes>::Zero());
-  level.PT.resize(source.PT.blocks.size() + 1, Eigen::Matrix<float, kModes, B>::Zero());
+  level.P.resize(source.transfer.P.blocks.size() + 1, Eigen::Matrix<float, B, kModes>::Zero());
+  level.R.resize(source.transfer.R.blocks.size() + 1, Eigen::Matrix<float, kModes, B>::Zero());
 }
 
 }  // namespace
 
 template <class Real>
 ReducedVCycle<Real>::ReducedVCycle(ch10::Multigrid& multigrid) : multigrid_(multigrid) {
-  if (multigrid.settings().smoother == ch10::MultigridSettings::Smoother::GaussSeidel)
+  if (multigrid.settings().relax.smoother == ch10::Smoother::GaussSeidel)
     throw std::invalid_argument(
         "float V-cycle: the polynomial smoothers only (Chebyshev, Jacobi), not Gauss-Seidel");
   size_level(fine_, multigrid.fine_level());
-  coarse_.resize(multigrid.levels() - 1);
-  for (int l = 1; l < multigrid.levels(); ++l)
-    size_level(coarse_[l - 1], multigrid.coarse_level(l));
+  coarse_.resize(multigrid.coarse_levels().size());
+  for (std::size_t l = 0; l < coarse_.size(); ++l)
+    size_level(coarse_[l], multigrid.coarse_levels()[l]);
   r_.setZero(fine_.source->dofs());
   s_.setZero(fine_.source->dofs());
 }
@@ -208,36 +202,37 @@ template <int B>
 void ReducedVCycle<Real>::convert(ReducedLevel<Real, B>& level, bool refreshed, bool collective) {
   const ch10::Level<B>& source = *level.source;
   if (source.coarsest) return;  // solved in double by chapter 10's Cholesky factor
-  for_parts(level, collective, [&](int first, int last) {
+  const ch10::Transfer<B>& transfer = source.transfer;
+  ch09::for_parts(source.rows.part, collective, [&](int first, int last) {
     for (int k = source.A.row_start[first]; k < source.A.row_start[last]; ++k)
       level.blocks[k] = source.values[k].template cast<float>();
     for (int i = first; i < last; ++i)
-      level.inverse_diagonal[i] = source.inverse_diagonal[i].template cast<float>();
+      level.inverse_diagonal[i] = source.smoother.inverse_diagonal[i].template cast<float>();
     if (!refreshed) return;
-    for (int m = source.P.row_start[first]; m < source.P.row_start[last]; ++m)
-      level.P[m] = source.P.blocks[m].template cast<float>();
+    for (int m = transfer.P.row_start[first]; m < transfer.P.row_start[last]; ++m)
+      level.P[m] = transfer.P.blocks[m].template cast<float>();
   });
   if (!refreshed) return;
-  on_one_thread(collective, [&] {
-    // P^T's rows belong to the coarse level's partition: few blocks, one thread.
-    for (std::size_t e = 0; e < source.PT.blocks.size(); ++e)
-      level.PT[e] = source.PT.blocks[e].template cast<float>();
-    level.chebyshev.assign(source.chebyshev.begin(), source.chebyshev.end());
+  ch09::on_one_thread(collective, [&] {
+    // R's rows belong to the coarse level's partition: few blocks, one thread.
+    for (std::size_t e = 0; e < transfer.R.blocks.size(); ++e)
+      level.R[e] = transfer.R.blocks[e].template cast<float>();
+    level.weights.assign(source.smoother.weights.begin(), source.smoother.weights.end());
   });
 }
 
 template <class Real>
 void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
-  multigrid_.prepare(A.blocks);
-  // Everything after a refresh, and the first time (a hierarchy prepared before this object
-  // existed); read by every thread after prepare's last barrier, written after convert's.
-  const bool refreshed = multigrid_.refreshed() || !converted_;
+  multigrid_.factorize(A.blocks);
+  // Everything after a refresh, and the first time (a hierarchy factorized before this object
+  // existed); read by every thread after factorize's last barrier, written after convert's.
+  const bool refreshed = multigrid_.refresh_rule().refreshed() || !converted_;
   convert(fine_, refreshed, true);
-  on_one_thread(true, [&] { converted_ = true; });
+  ch09::on_one_thread(true, [&] { converted_ = true; });
   if (!refreshed) return;
   for (auto& level : coarse_) {
-    if (level.source->serial)  // chapter 10 prepares a small level on one thread: so here
-      on_one_thread(true, [&] { convert(level, true, false); });
+    if (level.source->rows.serial)  // chapter 10 factorizes a small level on one thread: so here
+      ch09::on_one_thread(true, [&] { convert(level, true, false); });
     else
       convert(level, true, true);
   }
@@ -246,69 +241,20 @@ void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::
 template <class Real>
 void ReducedVCycle<Real>::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
                                 Eigen::VectorXd& s) {
-  multigrid_.count_cycle();  // the refresh rule counts V-cycles
+  multigrid_.refresh_rule().count_cycle();  // the refresh rule counts V-cycles
   if constexpr (std::is_same_v<Real, double>) {
-    cycle(fine_, 0, r, s, true);
+    ch10::v_cycle(fine_, coarse_, 0, r, s, true);
   } else {
-    for_parts(fine_, true, [&](int first, int last) {
+    const std::vector<int>& part = fine_.source->rows.part;
+    ch09::for_parts(part, true, [&](int first, int last) {
       r_.segment(3 * first, 3 * (last - first)) =
           r.segment(3 * first, 3 * (last - first)).template cast<float>();
     });
-    cycle(fine_, 0, r_, s_, true);
-    for_parts(fine_, true, [&](int first, int last) {
+    ch10::v_cycle(fine_, coarse_, 0, r_, s_, true);
+    ch09::for_parts(part, true, [&](int first, int last) {
       s.segment(3 * first, 3 * (last - first)) =
           s_.segment(3 * first, 3 * (last - first)).template cast<double>();
     });
-  }
-}
-
-// Chapter 10's cycle with a polynomial smoother: pre-smoothing from zero, ping-ponging between
-// x and y, the residual restricted, the coarse cycle, the correction prolonged, post-smoothing.
-template <class Real>
-template <int B>
-void ReducedVCycle<Real>::cycle(ReducedLevel<Real, B>& level, std::size_t next, const Vector& b,
-                                Vector& out, bool collective) {
-  const ch10::Level<B>& source = *level.source;
-  if (collective && source.serial) {
-    on_one_thread(true, [&] { cycle(level, next, b, out, false); });
-    return;
-  }
-  if (source.coarsest) {
-    // At most max_coarse_dofs unknowns: the dense solve stays in double, in chapter 10's factor.
-    on_one_thread(collective, [&] {
-      level.dense = b.template cast<double>();
-      if (source.cholesky.info() == Eigen::Success)
-        source.cholesky.solveInPlace(level.dense);
-      else
-        level.dense.setConstant(std::numeric_limits<double>::quiet_NaN());
-      out = level.dense.template cast<Real>();
-    });
-    return;
-  }
-  const int steps = static_cast<int>(level.chebyshev.size()) / 2;
-  const Vector* current = nullptr;
-  for (int k = 0; k < steps; ++k) {
-    Vector& target = k % 2 == 0 ? level.x : level.y;
-    for_parts(level, collective, [&](int first, int last) {
-      polynomial_step(level, k, first, last, b, current, target);
-    });
-    current = &target;
-  }
-  for_parts(level, collective,
-            [&](int first, int last) { residual(level, first, last, b, *current); });
-  ReducedLevel<Real, kModes>& coarse = coarse_[next];
-  for_parts(coarse, collective,
-            [&](int first, int last) { restrict_rows(level, coarse, first, last); });
-  cycle(coarse, next + 1, coarse.b, coarse.x, collective);
-  for_parts(level, collective,
-            [&](int first, int last) { prolong_rows(level, coarse, first, last, *current); });
-  current = &level.y;
-  for (int k = 0; k < steps; ++k) {
-    Vector& target = (steps - k) % 2 == 1 ? out : level.work;
-    for_parts(level, collective, [&](int first, int last) {
-      polynomial_step(level, k, first, last, b, current, target);
-    });
-    current = &target;
   }
 }
 
@@ -320,8 +266,8 @@ long long ReducedVCycle<Real>::number_bytes() const {
     if (source.coarsest) return 0LL;
     return static_cast<long long>(sizeof(level.blocks[0]) * source.A.column.size() +
                                   sizeof(level.inverse_diagonal[0]) * source.nodes() +
-                                  sizeof(level.P[0]) * source.P.blocks.size() +
-                                  sizeof(level.PT[0]) * source.PT.blocks.size());
+                                  sizeof(level.P[0]) * source.transfer.P.blocks.size() +
+                                  sizeof(level.R[0]) * source.transfer.R.blocks.size());
   };
   long long total = bytes(fine_);
   for (const auto& level : coarse_) total += bytes(level);

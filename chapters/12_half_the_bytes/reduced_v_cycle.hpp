@@ -7,12 +7,13 @@
 // a little, and PCG only needs M symmetric positive definite (AMGCL's mixed precision,
 // Demidov 2019; Tamstorf et al. 2015 precondition in the same spirit).
 //
-// The hierarchy itself is still chapter 10's Multigrid: it is set up and prepared in double
+// The hierarchy itself is still chapter 10's Multigrid: it is set up and factorized in double
 // (aggregates, Galerkin products, Chebyshev bounds, Cholesky), and this class reads its
-// numbers into float after each prepare(): the finest level every step, the coarse levels
-// after a refresh only. The V-cycle then runs in `Real` arithmetic on the float data:
-// Real = float (everything in single precision) or Real = double (float loads widened in
-// registers: the bytes of float, the rounding of double), the two the lesson measures.
+// numbers into float after each factorize(): the finest level every step, the coarse levels
+// after a refresh only. The V-cycle is chapter 10's (v_cycle.hpp), run on float levels in
+// `Real` arithmetic: Real = float (everything in single precision) or Real = double (float
+// loads widened in registers: the bytes of float, the rounding of double), the two the lesson
+// measures. Only its kernels are new (reduced_v_cycle.cpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -29,18 +30,27 @@ using ch10::kModes;
 // row blocks, the refresh rule and the coarsest Cholesky factor stay the source level's.
 template <class Real, int B>
 struct ReducedLevel {
-  using Vector = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
   const ch10::Level<B>* source = nullptr;
   std::vector<Eigen::Matrix<float, B, B>> blocks;            // the level's matrix
   std::vector<Eigen::Matrix<float, B, B>> inverse_diagonal;  // the smoother's D^-1
   std::vector<Eigen::Matrix<float, B, kModes>> P;            // the prolongator's blocks
-  std::vector<Eigen::Matrix<float, kModes, B>> PT;           // P^T's, in P^T's row order
-  std::vector<Real> chebyshev;                               // the smoother's weights
-  Vector b, x, y, work, direction;
+  std::vector<Eigen::Matrix<float, kModes, B>> R;            // the restriction's, in R's order
+  std::vector<Real> weights;                                 // the smoother's weights
+  ch10::WorkVectors<Real> vectors;
   Eigen::VectorXd dense;  // coarsest level: the right-hand side of the double Cholesky
 
   int nodes() const { return source->nodes(); }
 };
+
+// What chapter 10's V-cycle asks of a level, answered by the source level.
+template <class Real, int B>
+const ch10::RowBlocks& row_blocks(const ReducedLevel<Real, B>& level) {
+  return level.source->rows;
+}
+template <class Real, int B>
+bool is_coarsest(const ReducedLevel<Real, B>& level) {
+  return level.source->coarsest;
+}
 
 enum class Arithmetic { single, double_on_float };
 
@@ -53,23 +63,19 @@ class ReducedVCycle final : public ch09::Preconditioner {
   // (Chebyshev or Jacobi: chapter 10's default), which this V-cycle runs.
   explicit ReducedVCycle(ch10::Multigrid& multigrid);
 
-  // Chapter 10's prepare in double, then its new numbers into float. By every thread.
+  // Chapter 10's factorize in double, then its new numbers into float. By every thread.
   void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
   bool block_diagonal() const override { return false; }
   // s = M r, one V-cycle in Real arithmetic on the float numbers. By every thread.
   void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
 
-  // The bytes one V-cycle's numbers occupy: blocks, prolongators (P and P^T) and inverse
+  // The bytes one V-cycle's numbers occupy: blocks, prolongators (P and R) and inverse
   // diagonals of every level; chapter 10's in double are twice as many.
   long long number_bytes() const;
-  const ch10::Multigrid& multigrid() const { return multigrid_; }
 
  private:
   template <int B>
   void convert(ReducedLevel<Real, B>& level, bool refreshed, bool collective);
-  template <int B>
-  void cycle(ReducedLevel<Real, B>& level, std::size_t next, const Vector& b, Vector& out,
-             bool collective);
 
   ch10::Multigrid& multigrid_;
   ReducedLevel<Real, 3> fine_;

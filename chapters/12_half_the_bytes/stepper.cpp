@@ -16,16 +16,11 @@ std::unique_ptr<ch09::Preconditioner> reduced_v_cycle(ch10::Multigrid& multigrid
   return std::make_unique<ReducedVCycle<double>>(multigrid);
 }
 
-// total += mine from every thread once: an integer sum, exact in any order.
-void add_count(long long& total, long long mine) {
-#pragma omp atomic
-  total += mine;
-}
-
 }  // namespace
 
 HalfBytesStepper::HalfBytesStepper(const Scene& scene, const SolverSettings& settings,
-                                   Arithmetic arithmetic, const ch10::MultigridSettings& multigrid)
+                                   Arithmetic arithmetic,
+                                   const ch10::MultigridStepperSettings& multigrid)
     : NodeOrderStepper(scene, settings, ch11::Ordering::rcm, multigrid),
       arithmetic_(arithmetic),
       batched_(model_, scene_),
@@ -44,7 +39,7 @@ void HalfBytesStepper::element_pass(const State& state) {
   const int group = group_size(), elements = static_cast<int>(model_.tets.size());
   long long fallbacks = 0;
   ch09::run_parallel([&] {
-    BatchTerms terms;  // 6.5 KB on this thread's stack
+    BatchTerms terms;  // on this thread's stack: no allocation, no sharing
     long long mine = 0;
     for (std::size_t colour = 0; colour + 1 < start.size(); ++colour)
       for (const int k : ch09::StaticShare(start[colour], start[colour + 1])) {
@@ -56,7 +51,7 @@ void HalfBytesStepper::element_pass(const State& state) {
             scatter(terms, l, model_.tets[e + l], index_.element[e + l], A_, b_);
         }
       }
-    add_count(fallbacks, mine);
+    ch09::add_count(fallbacks, mine);
   });
   batched_.end_pass(fallbacks);
 }

@@ -19,7 +19,7 @@ class HalfBytesStepper final : public ch11::NodeOrderStepper {
   // float numbers, widened to double in registers (the lesson measures both).
   HalfBytesStepper(const Scene& scene, const SolverSettings& settings,
                    Arithmetic arithmetic = Arithmetic::single,
-                   const ch10::MultigridSettings& multigrid = {});
+                   const ch10::MultigridStepperSettings& multigrid = {});
 
   Arithmetic arithmetic() const { return arithmetic_; }
   const BatchedElements& batched_elements() const { return batched_; }

@@ -8,6 +8,7 @@
 
 #include "catch2_compat.hpp"
 #include "chapters/09_threads/stepper.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
@@ -29,14 +30,14 @@ Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
 // levels a poster-sized mesh has, so that every code path of the V-cycle runs.
 // Small row blocks (block_rows 4) give every level several blocks, so that the threads share
 // out the coarse levels too.
-using Smoother = ch10::MultigridSettings::Smoother;
+using Smoother = ch10::Smoother;
 constexpr Smoother kSmoothers[] = {Smoother::Chebyshev, Smoother::GaussSeidel, Smoother::Jacobi};
 
-ch10::MultigridSettings three_levels(Smoother smoother = ch10::MultigridSettings{}.smoother) {
-  ch10::MultigridSettings s;
-  s.max_coarse_dofs = 24;
-  s.smoother = smoother;
-  s.block_rows = 4;
+ch10::MultigridStepperSettings three_levels(Smoother smoother = ch10::SmootherSettings{}.smoother) {
+  ch10::MultigridStepperSettings s;
+  s.multigrid.max_coarse_dofs = 24;
+  s.multigrid.relax.smoother = smoother;
+  s.multigrid.rows.block_rows = 4;
   return s;
 }
 
@@ -57,7 +58,8 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
   // Every loop of prepare and of the V-cycle goes over fixed row blocks, every sum in a fixed
   // order, and the refresh rule reads only iteration counts: the thread count must not change
   // a bit, with the default settings and with every smoother on three levels of small blocks.
-  const auto run_with = [](const Scene& scene, int threads, const ch10::MultigridSettings& s) {
+  const auto run_with = [](const Scene& scene, int threads,
+                           const ch10::MultigridStepperSettings& s) {
     const ThreadCountScope scope(threads);
     ch10::MultigridStepper stepper(scene, {}, s);
     stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
@@ -65,7 +67,7 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
     for (int k = 0; k < 50; ++k) stepper.step(state);
     return state;
   };
-  std::vector<ch10::MultigridSettings> settings = {ch10::MultigridSettings{}};
+  std::vector<ch10::MultigridStepperSettings> settings = {ch10::MultigridStepperSettings{}};
   for (const Smoother smoother : kSmoothers) settings.push_back(three_levels(smoother));
   for (const Scene& scene : {test::test_scene("cantilever"), test::driven_scene()})
     for (const auto& s : settings) {
@@ -73,8 +75,8 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
       REQUIRE((reference.x - rest_state(scene).x).cwiseAbs().maxCoeff() > 1e-3);  // it moves
       for (const int threads : thread_counts()) {
         const State state = run_with(scene, threads, s);
-        INFO(scene.name << ", smoother " << static_cast<int>(s.smoother) << ", " << threads
-                        << " threads");
+        INFO(scene.name << ", smoother " << static_cast<int>(s.multigrid.relax.smoother) << ", "
+                        << threads << " threads");
         CHECK(bit_identical(state.x, reference.x));
         CHECK(bit_identical(state.v, reference.v));
       }
@@ -117,21 +119,21 @@ TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a re
     do {
       stepper.step(state);
       ++steps;
-    } while (!stepper.multigrid().refreshed() && steps < 100);
+    } while (!stepper.multigrid().refresh_rule().refreshed() && steps < 100);
     const ch10::Multigrid& mg = stepper.multigrid();
-    REQUIRE(mg.refreshed());
+    REQUIRE(mg.refresh_rule().refreshed());
     REQUIRE(mg.levels() == 3);
     // The finest level is the stepper's filtered system itself.
-    CHECK((mg.level_matrix(0) - stepper.system_matrix().to_sparse()).norm() == 0.0);
+    CHECK((ch10::level_matrix(mg, 0) - stepper.system_matrix().to_sparse()).norm() == 0.0);
     for (int l = 0; l + 1 < mg.levels(); ++l) {
-      const Eigen::SparseMatrix<double> P = mg.prolongator(l);
-      const Eigen::SparseMatrix<double> A = mg.level_matrix(l);
+      const Eigen::SparseMatrix<double> P = ch10::prolongator(mg, l);
+      const Eigen::SparseMatrix<double> A = ch10::level_matrix(mg, l);
       Eigen::SparseMatrix<double> expected = Eigen::SparseMatrix<double>(P.transpose()) * A * P;
       // Modes an aggregate lacks have zero rows and columns there, and the identity instead.
-      const Eigen::VectorXd unused = mg.unused_modes(l + 1);
+      const Eigen::VectorXd unused = ch10::missing_modes(mg, l + 1);
       for (Eigen::Index k = 0; k < unused.size(); ++k)
         if (unused[k] != 0.0) expected.coeffRef(k, k) += unused[k];
-      const Eigen::SparseMatrix<double> coarse = mg.level_matrix(l + 1);
+      const Eigen::SparseMatrix<double> coarse = ch10::level_matrix(mg, l + 1);
       INFO(scene.name << ", level " << l + 1 << ": " << coarse.rows() << " unknowns");
       CHECK(coarse.rows() == P.cols());
       CHECK((coarse - expected).norm() <= 1e-12 * expected.norm());
@@ -142,16 +144,16 @@ TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a re
 TEST_CASE("ch10: a mode is unused exactly where its prolongator column is zero", "[ch10]") {
   for (const int modes : {6, 3}) {
     for (const Scene& scene : all_scenes()) {
-      ch10::MultigridSettings settings = three_levels();
-      settings.modes = modes;
+      ch10::MultigridStepperSettings settings = three_levels();
+      settings.multigrid.coarsening.modes = modes;
       ch10::MultigridStepper stepper(scene, {}, settings);
       State state = rest_state(scene);
       stepper.step(state);
       CHECK(stepper.profile().converged);
       const ch10::Multigrid& mg = stepper.multigrid();
       for (int l = 0; l + 1 < mg.levels(); ++l) {
-        const Eigen::SparseMatrix<double> P = mg.prolongator(l);
-        const Eigen::VectorXd unused = mg.unused_modes(l + 1);
+        const Eigen::SparseMatrix<double> P = ch10::prolongator(mg, l);
+        const Eigen::VectorXd unused = ch10::missing_modes(mg, l + 1);
         int zero_columns = 0;
         for (Eigen::Index k = 0; k < P.cols(); ++k) {
           const bool zero = P.col(k).norm() == 0.0;
@@ -210,46 +212,46 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   const Scene scene = test::test_scene("cantilever");
   ch10::MultigridStepper stepper(scene, {});
   const std::vector<Eigen::Matrix3d> wrong(3, Eigen::Matrix3d::Identity());
-  CHECK_THROWS_AS(stepper.multigrid().prepare(wrong), std::invalid_argument);
-  ch10::MultigridSettings bad;
-  bad.modes = 4;
+  CHECK_THROWS_AS(stepper.multigrid().factorize(wrong), std::invalid_argument);
+  ch10::MultigridStepperSettings bad;
+  bad.multigrid.coarsening.modes = 4;
   CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
 }
 
 TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle", "[ch10]") {
   // A lagged V-cycle is still SPD, so PCG reaches the same tolerance: only iterations change.
   const Scene scene = test::driven_scene();
-  ch10::MultigridSettings every_step = three_levels(), lagged = three_levels();
-  every_step.coarse_refresh = 1;
-  lagged.coarse_refresh = 5;  // every fifth step only: the rule without its early refresh
-  lagged.refresh_growth = 0.0;
+  ch10::MultigridStepperSettings every_step = three_levels(), lagged = three_levels();
+  every_step.multigrid.refresh.every = 1;
+  lagged.multigrid.refresh.every = 5;  // every fifth step only: the rule without its early refresh
+  lagged.multigrid.refresh.growth = 0.0;
   ch10::MultigridStepper fresh(scene, test::tight_solver(), every_step);
   ch10::MultigridStepper stale(scene, test::tight_solver(), lagged);
   State a = rest_state(scene), b = rest_state(scene);
   const Eigen::VectorXd X = a.x;
   double motion = 0.0, difference = 0.0;
   for (int k = 0; k < 20; ++k) {
-    const Eigen::SparseMatrix<double> coarse = stale.multigrid().level_matrix(1);
+    const Eigen::SparseMatrix<double> coarse = ch10::level_matrix(stale.multigrid(), 1);
     fresh.step(a);
     stale.step(b);
     CHECK(stale.profile().converged);
     // Between refreshes the coarse matrices are the old ones, to the bit.
-    if (k > 0 && !stale.multigrid().refreshed())
-      CHECK((stale.multigrid().level_matrix(1) - coarse).norm() == 0.0);
+    if (k > 0 && !stale.multigrid().refresh_rule().refreshed())
+      CHECK((ch10::level_matrix(stale.multigrid(), 1) - coarse).norm() == 0.0);
     motion = std::max(motion, (a.x - X).cwiseAbs().maxCoeff());
     difference = std::max(difference, (a.x - b.x).cwiseAbs().maxCoeff());
   }
-  CHECK(fresh.multigrid().refreshes() == 20);
-  CHECK(stale.multigrid().refreshes() == 4);  // steps 1, 6, 11 and 16
+  CHECK(fresh.multigrid().refresh_rule().refreshes() == 20);
+  CHECK(stale.multigrid().refresh_rule().refreshes() == 4);  // steps 1, 6, 11 and 16
   INFO("max |dx| " << difference << " of motion " << motion);
   CHECK(difference < 1e-8 * motion);
   // The last step (the 20th) kept the coarse matrices of the 16th: still SPD.
   for (const Smoother smoother : kSmoothers) {
-    lagged.smoother = smoother;
+    lagged.multigrid.relax.smoother = smoother;
     ch10::MultigridStepper stepper(scene, {}, lagged);
     State state = rest_state(scene);
     for (int k = 0; k < 8; ++k) stepper.step(state);
-    REQUIRE(!stepper.multigrid().refreshed());
+    REQUIRE(!stepper.multigrid().refresh_rule().refreshed());
     std::srand(11);
     const Eigen::Index n = X.size();
     const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
@@ -291,9 +293,10 @@ Soak soak(const Scene& scene, int threads, int steps) {
     }
     out.not_converged += stepper.profile().converged ? 0 : 1;
     out.most_iterations = std::max(out.most_iterations, stepper.profile().cg_iterations);
-    if (mouse.just_jumped(k, 3) && stepper.multigrid().refreshed()) ++out.jump_refreshes;
+    if (mouse.just_jumped(k, 3) && stepper.multigrid().refresh_rule().refreshed())
+      ++out.jump_refreshes;
   }
-  out.refreshes = stepper.multigrid().refreshes();
+  out.refreshes = stepper.multigrid().refresh_rule().refreshes();
   return out;
 }
 
@@ -314,7 +317,7 @@ TEST_CASE("ch10: soak, thousands of steps under a jumping mouse spring, 1 and 2 
     CHECK(r.most_iterations <= 16);
     // The rule refreshes every k-th step and when the iterations grow: the jumps trigger
     // refreshes beyond the periodic ones, most of them within 3 steps of the jump.
-    const int k = ch10::MultigridSettings{}.coarse_refresh;
+    const int k = ch10::RefreshSettings{}.every;
     CHECK(r.refreshes > steps / k);
     CHECK(r.jump_refreshes > steps / 50 / 2);
   }

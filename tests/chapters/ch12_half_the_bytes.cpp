@@ -9,6 +9,7 @@
 
 #include "catch2_compat.hpp"
 #include "chapters/08_element_kernels/element_kernels.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/element_batch.hpp"
@@ -31,10 +32,10 @@ Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
 }
 
 // Three levels on the 190-node test mesh, small row blocks (as chapter 10's tests).
-ch10::MultigridSettings three_levels() {
-  ch10::MultigridSettings s;
-  s.max_coarse_dofs = 24;
-  s.block_rows = 4;
+ch10::MultigridStepperSettings three_levels() {
+  ch10::MultigridStepperSettings s;
+  s.multigrid.max_coarse_dofs = 24;
+  s.multigrid.rows.block_rows = 4;
   return s;
 }
 
@@ -96,9 +97,9 @@ TEST_CASE("ch12: the float numbers are chapter 10's rounded, and half their byte
   long long double_bytes = 0;
   for (int l = 0; l < mg.levels() - 1; ++l) {
     const int b = l == 0 ? 3 : ch10::kModes;
-    double_bytes += 8LL * b * b * mg.level_blocks(l);
-    double_bytes += 8LL * b * b * (mg.level_dofs(l) / b);
-    double_bytes += 2 * 8LL * b * ch10::kModes * mg.prolongator_blocks(l);
+    double_bytes += 8LL * b * b * ch10::level_blocks(mg, l);
+    double_bytes += 8LL * b * b * (ch10::level_dofs(mg, l) / b);
+    double_bytes += 2 * 8LL * b * ch10::kModes * ch10::prolongator_blocks(mg, l);
   }
   CHECK(2 * single.number_bytes() == double_bytes);
 }
@@ -132,8 +133,8 @@ TEST_CASE("ch12: at most one iteration more than chapter 11 at 1e-4, and 1e-10 s
 }
 
 TEST_CASE("ch12: refuses chapter 10's Gauss-Seidel smoother", "[ch12]") {
-  ch10::MultigridSettings s;
-  s.smoother = ch10::MultigridSettings::Smoother::GaussSeidel;
+  ch10::MultigridStepperSettings s;
+  s.multigrid.relax.smoother = ch10::Smoother::GaussSeidel;
   CHECK_THROWS_AS(
       ch12::HalfBytesStepper(test::test_scene("cantilever"), {}, ch12::Arithmetic::single, s),
       std::invalid_argument);

@@ -34,8 +34,8 @@ TEST_CASE("divergence: a capped solve is a failed step only when worse than no s
 }
 
 TEST_CASE("divergence: nu = 0.49999999 fails the first step in every chapter", "[divergence]") {
-  // (At nu = 0.4999999 chapter 10's multigrid now gets the first step's residual below 1 in
-  // 500 iterations and converges in 2000: a near-incompressible failure needs one more 9.)
+  // (Near nu = 0.5 the system's condition number grows without bound; a nu this close fails
+  // even the strongest preconditioner's first step within the iteration cap.)
   Material nearly_incompressible;
   nearly_incompressible.youngs_modulus = 2e5;
   nearly_incompressible.poisson_ratio = 0.49999999;

@@ -6,6 +6,7 @@
 #include "catch2_compat.hpp"
 #include "chapters/01_naive/stepper.hpp"
 #include "chapters/07_block_sparse/stepper.hpp"
+#include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/registry.hpp"
 #include "support.hpp"
@@ -73,13 +74,13 @@ TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofl
   REQUIRE(int(levels.size()) == stepper.multigrid().levels());
   CHECK(levels.back().coarsest);
   for (std::size_t l = 0; l < levels.size(); ++l) {
-    const auto A = stepper.multigrid().level_matrix(int(l));  // an independent conversion
+    const auto A = ch10::level_matrix(stepper.multigrid(), int(l));  // an independent conversion
     const int b = levels[l].block;
     CHECK(double(levels[l].nodes * b) == double(A.rows()));
     CHECK(double(levels[l].blocks) * b * b >= double(A.nonZeros()));  // zero entries not stored
     if (!levels[l].coarsest)
       CHECK(double(levels[l].transfer) * b * ch10::kModes >=
-            double(stepper.multigrid().prolongator(int(l)).nonZeros()));
+            double(ch10::prolongator(stepper.multigrid(), int(l)).nonZeros()));
   }
   // A float V-cycle streams fewer bytes than a double one over the same levels.
   const int products = roofline::smoother_products(stepper.multigrid());

@@ -110,7 +110,7 @@ EXERCISES = [
      "test": "./tutorial.sh test -L ch09_NAME", "test_passes": False,
      "failing": "the same state to the last bit on 1, 2 and 3 threads"},
     {"id": "10/4", "chapter": "10", "name": "ex_yardstick",
-     "change": [("multigrid.cpp",
+     "change": [("refresh_rule.cpp",
                  "    measure_next_ = false;\n  }\n",
                  "    measure_next_ = false;\n  } else if (!measure_next_) {\n"
                  "    cycles_after_refresh_ = std::min(cycles_after_refresh_, last);\n  }\n")],
@@ -137,7 +137,7 @@ EXERCISES = [
      "expect": "measured",
      "lesson": "build/release/fem_lessons half-the-bytes --chapter 12_NAME"},
     {"id": "12/4", "chapter": "12", "name": "ex_lanes",
-     "change": [("element_batch.hpp", "constexpr int kLanes = 8;", "constexpr int kLanes = 4;")],
+     "change": [("batch_rotations.hpp", "constexpr int kLanes = 8;", "constexpr int kLanes = 4;")],
      "bench": "build/release/fem_bench --chapters 12,12_NAME --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons batched-elements --chapter 12_NAME"},

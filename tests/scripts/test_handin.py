@@ -7,6 +7,7 @@ failed' last.
 
     test_handin.py --bench build/release/fem_bench"""
 import argparse
+import json
 import pathlib
 import subprocess
 import sys
@@ -22,8 +23,8 @@ def check(name, condition, detail=""):
     print(f"{'ok  ' if condition else 'FAIL'} {name}{'' if condition else ': ' + str(detail)[:3000]}")
 
 
-def run(*args):
-    return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=ROOT)
+def run(*args, cwd=ROOT):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd)
 
 
 def main():
@@ -47,10 +48,36 @@ def main():
               p.returncode == 0 and (student / "bench.json").read_bytes() == first
               and (exercise / "bench.json").exists(), p.stderr)
         p = run(*bench, "--out", student, "--no-solvers")
-        check("a run into an existing folder says it replaces that run",
-              "replacing the run that was there" in p.stdout, p.stdout[-300:])
-        p = run(*bench, "--out", student)  # the hand-in: a full run again
+        check("a run into a folder that holds a run is refused before the work, the run kept",
+              p.returncode == 2 and "--replace" in p.stderr and "interleaved" not in p.stdout
+              and (student / "bench.json").read_bytes() == first, p.stdout[-300:] + p.stderr)
+        p = run(*bench, "--out", student, "--no-solvers", "--replace")
+        check("--replace replaces it and says so",
+              p.returncode == 0 and "replacing the run that was there" in p.stdout, p.stdout[-300:])
+        p = run(*bench, "--out", student, "--replace")  # the hand-in: a full run again
         first = (student / "bench.json").read_bytes()
+
+        # Without --out: a new folder per run under results/, and results/latest the newest.
+        default = tmp / "default"
+        default.mkdir()
+        for _ in range(2):
+            p = run(*bench, "--no-solvers", cwd=default)
+        folders = sorted(d.name for d in (default / "results").glob("run-*"))
+        latest = default / "results" / "latest"
+        check("two runs without --out make two folders, results/latest the second",
+              p.returncode == 0 and len(folders) == 2 and latest.is_symlink()
+              and latest.resolve() == (default / "results" / folders[-1]).resolve()
+              and all((default / "results" / f / "bench.json").exists() for f in folders),
+              f"{folders} {p.stderr}")
+
+        # The JSON ties each chapter's row to its sources: the hash the build recorded equals the
+        # one the hand-in check computes from the folder (scripts/check_handin.py).
+        sys.path.insert(0, str(ROOT / "scripts"))
+        import check_handin  # noqa: E402
+        rows = json.loads((student / "bench.json").read_text())["chapters"]
+        check("each row records the hash of its chapter's sources, as the hand-in check computes it",
+              all(r.get("source_hash") == check_handin.source_hash(ROOT / "chapters" / r["chapter"])
+                  for r in rows), [r.get("source_hash") for r in rows])
         p = run(*bench, "--out", "", "--json", tmp / "only.json", "--no-solvers")
         check("--json FILE still writes just that file", p.returncode == 0 and (tmp / "only.json").exists()
               and not (ROOT / "bench.json").exists(), p.stderr)

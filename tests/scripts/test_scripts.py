@@ -113,6 +113,21 @@ def main():
               str([(c["chapter"], r["chapter"]) for c, r in pairs]))
         check("each variant row's speedup over its original is the measured one (x2)",
               all(r["median_ms"]["step"] / c["median_ms"]["step"] == 2.0 for c, r in pairs))
+        # The variant's run drawn: the plots' layout checks (no legend over a bar, no tick labels
+        # into each other) pass on it, and they do catch a legend laid over the bars.
+        (out / "variant").mkdir()
+        (out / "variant" / "bench.json").write_text(json.dumps(variant_run))
+        p = run(SCRIPTS / "plot_results.py", out / "variant" / "bench.json", "--out", out / "variant")
+        check("a variant's run draws readable plots (the layout checks pass)", p.returncode == 0,
+              p.stdout + p.stderr)
+        import matplotlib.pyplot as plt  # noqa: E402
+        fig, ax = plt.subplots()
+        ax.bar([0, 1, 2], [3, 3, 3], label="bars")
+        ax.legend(loc="center")
+        fig.canvas.draw()
+        check("the layout check finds a legend that covers bars",
+              any("legend" in problem for problem in plot_results.layout_problems(fig)))
+        plt.close(fig)
         two = copy.deepcopy(bench)
         two["chapters"] = [c for c in bench["chapters"] if c["chapter"] != "01_naive"][:2]
         pairs, ylabel, _ = plot_results.speedup_references(two)
@@ -245,6 +260,33 @@ def main():
         p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
         check("check_chapter_sources.py accepts a chapter that names only itself",
               p.returncode == 0, p.stdout + p.stderr)
+
+        # The size limits: a long function, a long file and a wide struct are caught, and the
+        # same code within the limits (a brace in a string, an initializer, a long stepper of
+        # an early chapter) is not.
+        sizes = tmp / "sizes"
+        for folder in ("chapters/09_wide", "chapters/03_early", "common", "apps"):
+            (sizes / folder).mkdir(parents=True)
+        body = "".join(f"  x += {k};\n" for k in range(59))
+        (sizes / "common" / "long.cpp").write_text(
+            'int f(int x) {\n  const char* s = "}";\n' + body + "}\n"
+            "Foo::Foo() : a_{1}, b_(2) {\n" + body[:-11] + "}\n")
+        members = "".join(f"  double m{k} = {{}};\n" for k in range(17))
+        (sizes / "chapters" / "09_wide" / "wide.hpp").write_text(
+            "struct Wide {\n  using T = int;\n  static constexpr int k = 1;\n  int f() const;\n"
+            + members + "  struct Inner {\n    int a, b;\n  } inner, other;\n};\n")
+        (sizes / "chapters" / "03_early" / "stepper.hpp").write_text(
+            "struct Early {\n" + members + "  int more, still_more;\n};\n" + "\n" * 400)
+        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
+        check("check_sizes.py catches a long function, a long chapter file and a wide struct",
+              p.returncode == 1 and "f is 62 lines" in p.stderr and "Foo::Foo" not in p.stderr
+              and "Wide has 19 data members" in p.stderr and "Inner" not in p.stderr
+              and "stepper.hpp: 420 lines" in p.stderr and "Early has" not in p.stderr, p.stderr)
+        (sizes / "common" / "long.cpp").write_text("int f(int x) {\n" + body[:-11] + "}\n")
+        (sizes / "chapters" / "09_wide" / "wide.hpp").write_text("struct Wide {\n" + members + "};\n")
+        (sizes / "chapters" / "03_early" / "stepper.hpp").write_text("struct Early {};\n")
+        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
+        check("check_sizes.py accepts code within the limits", p.returncode == 0, p.stdout + p.stderr)
 
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0

@@ -113,11 +113,17 @@ def main():
         text = generated.read_text() if generated.exists() else ""
         check("the variant is registered with its original",
               'chapter<fem::ch06_my_fused_updates::CustomPcgStepper>("06_my_fused_updates", '
-              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg", nullptr),' in text, text)
+              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg", nullptr,' in text, text)
         check("the originals keep their entries",
               'chapter<fem::ch06::CustomPcgStepper>("06_custom_pcg"' in text
-              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "", nullptr)' in text
-              and '"", &fem::ch08::lessons)' in text, text)
+              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "", nullptr,' in text
+              and '"", &fem::ch08::lessons,' in text, text)
+        # Each entry ends with the hash of its chapter's sources, as the hand-in check computes it.
+        sys.path.insert(0, str(repo / "scripts"))
+        import check_handin  # noqa: E402
+        check("each entry records its chapter's source hash",
+              f'"{check_handin.source_hash(variant)}"' in text
+              and f'"{check_handin.source_hash(repo / "chapters" / "01_naive")}"' in text, text[-1500:])
 
         # Original and variant compile side by side (no clash of names), the variant's own file too.
         flags = ["-std=c++17", "-fsyntax-only", f"-I{repo}", *[f"-I{i}" for i in args.include],

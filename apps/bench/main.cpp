@@ -1,0 +1,70 @@
+// fem_bench: measures every chapter on the same scene and mesh, in one process so that the
+// ratios between chapters hold while the machine's speed drifts. Prints the per-phase table
+// (median ms, allocations per step) and the solve table, and writes them as JSON. One job per
+// file: options (the command line), chapter_runs (the interleaved chapters), solve_tables
+// (the poster's solve table), report_console and report_json (the results), run_folder (the
+// results' folder); the order statistics are common/statistics.hpp's.
+#include <filesystem>
+#include <iostream>
+
+#include "apps/bench/chapter_runs.hpp"
+#include "apps/bench/options.hpp"
+#include "apps/bench/report_console.hpp"
+#include "apps/bench/report_json.hpp"
+#include "apps/bench/run_folder.hpp"
+#include "apps/bench/solve_tables.hpp"
+
+using namespace fem;
+using namespace fem::bench;
+
+namespace {
+
+std::vector<SolverResult> solve_tables(const Scene& scene, const BenchOptions& options) {
+  std::cout << "\nrunning the solve table (every solver on the same systems)\n" << std::flush;
+  std::vector<SolverResult> solvers = run_solvers(scene, options.solver, options.schedule);
+  for (auto& s :
+       run_threaded_solvers(scene, options.solver, options.thread_counts, options.schedule))
+    solvers.push_back(std::move(s));
+  print_solvers(solvers);
+  return solvers;
+}
+
+int run_bench(const ArgParser& args) {
+  const BenchOptions options = bench_options(args);
+  // The scene before the folder: a bad mesh or material leaves no empty run folder behind.
+  const Scene scene = scene_from_args(args);
+  if (!options.json.empty()) check_writable(options.json);
+  const SourceState source = source_state();
+  print_setup(scene, options, source);
+  LoadMonitor load;
+  std::cout << "running " << options.chapters.size()
+            << " chapters interleaved, one step each in turn\n";
+  const std::vector<ChapterResult> results = run_chapters(options.chapters, scene, options.solver,
+                                                          options.thread_counts, options.schedule);
+  print_chapters(results);
+  const std::vector<SolverResult> solvers =
+      options.solve_tables ? solve_tables(scene, options) : std::vector<SolverResult>{};
+  load.stop();
+  if (const std::string& path = options.json; !path.empty()) {
+    const bool replaced = std::filesystem::exists(path);
+    const int removed = options.json_named ? 0 : remove_previous_plots(path);
+    write_json(path, scene, options, results, solvers, load, source);
+    std::cout << "\nwrote " << path
+              << (replaced ? " (--replace: replacing the run that was there" : "")
+              << (replaced && removed ? ", and its plots" : "") << (replaced ? ")" : "") << "\n";
+    if (!options.latest.empty()) point_latest_at(options.latest);
+  }
+  if (const std::string warning = load.warning(); !warning.empty()) std::cerr << warning << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ArgParser args("fem_bench",
+                 "Benchmarks chapters on one scene: per-phase median ms, allocations per step,\n"
+                 "CG iterations; prints a table and writes JSON (schema in README.md) into the\n"
+                 "run's folder (--out), where ./tutorial.sh bench also writes the plots.");
+  add_bench_options(args);
+  return run_program("fem_bench", [&] { return args.parse(argc, argv) ? run_bench(args) : 0; });
+}

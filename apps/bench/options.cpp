@@ -1,0 +1,147 @@
+#include "apps/bench/options.hpp"
+
+#include <algorithm>
+#include <ctime>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "common/build_info.hpp"
+#include "common/threads.hpp"
+
+namespace fem::bench {
+
+namespace {
+
+// "1,2,4" -> {1, 2, 4}; empty -> 1 and OpenMP's count (OMP_NUM_THREADS or every core).
+std::vector<int> parse_thread_counts(const std::string& list) {
+  if (list.empty()) {
+    std::vector<int> out = {1};
+    if (max_threads() > 1) out.push_back(max_threads());
+    return out;
+  }
+  std::vector<int> out;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const std::optional<int> parsed = parse_int(item);
+    if (!parsed || *parsed < 1)
+      throw UsageError("--threads expects thread counts >= 1 separated by commas, got '" + list +
+                       "'");
+    const int n = *parsed;
+    try {
+      if (const std::string warning = check_thread_count(n); !warning.empty())
+        std::cerr << "fem_bench: warning: --threads " << item << ": " << warning << "\n";
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--threads " + item + ": " + e.what());
+    }
+    if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
+  }
+  return out;
+}
+
+std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
+  std::vector<const ChapterInfo*> out;
+  if (list == "all") {
+    for (const auto& c : chapters()) out.push_back(&c);
+    return out;
+  }
+  std::stringstream in(list);
+  std::string name;
+  while (std::getline(in, name, ',')) {
+    const ChapterInfo* found = nullptr;
+    try {
+      found = &find_chapter(name);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    // Twice the same chapter would be two rows of one name in every table and plot.
+    if (std::find(out.begin(), out.end(), found) != out.end())
+      throw UsageError("--chapters names " + found->id + " twice");
+    out.push_back(found);
+  }
+  if (out.empty()) throw UsageError("--chapters is empty");
+  return out;
+}
+
+// Without --out, a new folder per run, results/run-YYYYMMDD-HHMMSS (a second run in the same
+// second gets -2, -3, ...): a run never replaces an earlier one unless asked (--replace).
+std::string new_run_folder() {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "run-%Y%m%d-%H%M%S", std::localtime(&now));
+  std::string folder = std::string("results/") + stamp;
+  for (int k = 2; std::filesystem::exists(folder); ++k)
+    folder = std::string("results/") + stamp + "-" + std::to_string(k);
+  return folder;
+}
+
+// --json FILE, else DIR/bench.json of --out DIR; "" with --no-json or when both are empty.
+std::string json_path(const ArgParser& args) {
+  if (args.has_flag("no-json")) {
+    if (args.has_flag("json") && !args.get("json").empty())
+      throw UsageError("--no-json and --json " + args.get("json") + " contradict each other");
+    return "";
+  }
+  if (!args.get("json").empty()) return args.get("json");
+  const std::string out = args.get("out").empty() ? new_run_folder() : args.get("out");
+  return (std::filesystem::path(out) / "bench.json").string();
+}
+
+Schedule schedule(const ArgParser& args) {
+  const int steps = args.get_int("steps"), warmup = args.get_int("warmup");
+  const Schedule s{warmup, steps};
+  if (s.steps <= 0) throw UsageError("--steps must be positive");
+  if (s.warmup < 1)
+    throw UsageError(
+        "--warmup must be >= 1: the first step allocates the stepper's buffers, and "
+        "the allocations per step are those of the steps after it");
+  return s;
+}
+
+}  // namespace
+
+void add_bench_options(ArgParser& args) {
+  add_scene_options(args, "meshes/plate_poster.msh");
+  add_solver_options(args);
+  args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
+  args.option("steps", "N", "measured steps per chapter, > 0", "100");
+  args.option("warmup", "N",
+              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)",
+              "10");
+  args.option("out", "DIR",
+              "the run's folder: writes DIR/bench.json (default: a new folder "
+              "results/run-DATE-TIME, and results/latest points to it); a folder that holds a "
+              "run is refused unless --replace",
+              "");
+  args.flag("replace", "replace the run (bench.json and its plots) in --out DIR or at --json FILE");
+  args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
+  args.flag("no-json", "write no JSON (print the tables only)");
+  args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
+  args.option("threads", "LIST",
+              "thread counts for the parallel chapters (09 on), comma-separated (default: 1 and "
+              "OMP_NUM_THREADS, else 1 and all " +
+                  std::to_string(hardware_threads()) + ")",
+              "");
+}
+
+BenchOptions bench_options(const ArgParser& args) {
+  BenchOptions o;
+  o.chapters = parse_chapters(args.get("chapters"));
+  o.schedule = schedule(args);
+  o.solver = solver_from_args(args);
+  o.thread_counts = parse_thread_counts(args.get("threads"));
+  o.json = json_path(args);
+  o.json_named = !args.get("json").empty();
+  o.replace = args.has_flag("replace");
+  if (!o.json.empty() && !o.json_named && args.get("out").empty())
+    o.latest = std::filesystem::path(o.json).parent_path().filename().string();
+  if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))
+    throw UsageError("'" + o.json +
+                     "' holds an earlier run: give another --out (or --json), or --replace to "
+                     "replace it and its plots");
+  o.solve_tables = !args.has_flag("no-solvers");
+  return o;
+}
+
+}  // namespace fem::bench

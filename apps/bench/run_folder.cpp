@@ -1,0 +1,53 @@
+#include "apps/bench/run_folder.hpp"
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "common/cli.hpp"
+
+namespace fem::bench {
+
+namespace fs = std::filesystem;
+
+void check_writable(const std::string& path) {
+  const fs::path file(path);
+  std::error_code error;
+  if (const fs::path dir = file.parent_path(); !dir.empty()) {
+    fs::create_directories(dir, error);
+    if (error || !fs::is_directory(dir))
+      throw UsageError("cannot write the results into '" + dir.string() +
+                       "': " + (error ? error.message() : "not a directory"));
+  }
+  if (fs::is_directory(file)) throw UsageError("'" + path + "' is a directory, not a JSON file");
+  const bool existed = fs::exists(file);
+  if (!std::ofstream(file, std::ios::app))
+    throw UsageError("cannot write '" + path + "' (permissions?)");
+  if (!existed) fs::remove(file, error);
+}
+
+void point_latest_at(const std::string& folder) {
+  const fs::path link = fs::path("results") / "latest";
+  std::error_code error;
+  if (fs::is_symlink(link, error) || !fs::exists(link, error)) fs::remove(link, error);
+  fs::create_directory_symlink(folder, link, error);
+  if (error)
+    std::cerr << "fem_bench: warning: cannot point " << link.string() << " at " << folder << ": "
+              << error.message() << "\n";
+  else
+    std::cout << "results/latest -> " << folder << "\n";
+}
+
+int remove_previous_plots(const std::string& json) {
+  // The plots scripts/plot_results.py makes of a run.
+  constexpr std::array<const char*, 5> kRunPlots = {
+      "phases.png", "phases_stacked.png", "speedup.png", "allocations.png", "solvers.png"};
+  int removed = 0;
+  std::error_code error;
+  for (const char* name : kRunPlots)
+    removed += fs::remove(fs::path(json).parent_path() / name, error) ? 1 : 0;
+  return removed;
+}
+
+}  // namespace fem::bench
