@@ -72,6 +72,12 @@ commands:
              record them in docs/data/lessons/*.json and write them into the chapter READMEs
              (ctest -L docs checks that the READMEs hold the recorded tables), and the data of
              the figures (fem_figure_data: docs/data/figures/*.json); part of docs
+  roofline   build and measure this machine's roofs (read bandwidth of each cache level and of
+             memory, peak multiply-add rate in double and float, on 1 and every thread) and place
+             every chapter's phases under them (fem_lessons roofline; a few minutes):
+             results/roofline.json and results/roofline.png (docs/roofline.md explains them);
+             --out DIR for another run folder, other arguments go to fem_lessons roofline
+             (--chapters 12,12_mine, --meshes, --steps; fem_lessons roofline --help)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
              out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
   viewer-bench
@@ -358,6 +364,13 @@ lessons() {
     --json docs/data/lessons/batched-elements.json >/dev/null
   "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
+  # The course's closing page: the roofs and every chapter on the plate, the last chapter on
+  # the 82k-node beam too when it was generated (docs/roofline.md, docs/images/roofline.png).
+  local beam=""
+  [ -f meshes/generated/beam_100k.msh ] && beam="meshes/generated/beam_100k.msh"
+  "$BUILD_DIR/fem_lessons" roofline --steps 20 --meshes "$beam" \
+    --json docs/data/lessons/roofline.json >/dev/null
+  "$VENV/bin/python" scripts/plot_roofline.py docs/data/lessons/roofline.json --out docs/images/roofline.png
   "$VENV/bin/python" scripts/lesson_tables.py
   # The code's own data behind the figures of chapters 10 and 11 (scripts/figures.py draws them).
   mkdir -p docs/data/figures
@@ -365,6 +378,17 @@ lessons() {
     --json docs/data/figures/hierarchy.json
   "$BUILD_DIR/fem_figure_data" node-orders --mesh meshes/beam_10k.msh \
     --json docs/data/figures/node-orders.json
+}
+
+# This machine's roofs and every chapter under them, into a run folder (results/ by default).
+roofline() {
+  quiet_build
+  local out=results
+  if [ "${1:-}" = "--out" ]; then out="$2"; shift 2; fi
+  mkdir -p "$out"
+  log "the roofline: this machine's roofs and every chapter's phases under them, into $out/"
+  "$BUILD_DIR/fem_lessons" roofline --json "$out/roofline.json" "$@"
+  "$VENV/bin/python" scripts/plot_roofline.py "$out/roofline.json" --out "$out/roofline.png"
 }
 
 docs() {
@@ -445,6 +469,7 @@ main() {
     threads) threads "$@" ;;
     docs) docs ;;
     lessons) lessons ;;
+    roofline) roofline "$@" ;;
     sim) sim "$@" ;;
     viewer) viewer "$@" ;;
     viewer-bench) viewer_bench "$@" ;;

@@ -2,7 +2,8 @@
 // with --readme, written between marker comments of a chapter's README, so that no number
 // in a lesson is typed by hand). Each lesson's code lives in its chapter
 // (chapters/NN_name/lesson.cpp); this program finds it through the chapter registry, and
-// with --chapter runs a student's variant's copy beside the original's.
+// with --chapter runs a student's variant's copy beside the original's. A lesson of the whole
+// course, not of one chapter (the roofline, apps/roofline/), is registered here.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/roofline/lesson.hpp"
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
@@ -22,16 +24,17 @@ namespace {
 using namespace fem;
 
 struct Found {
-  const ChapterInfo* chapter;
+  const ChapterInfo* chapter;  // null for a lesson of the whole course
   Lesson lesson;
 };
 
-// Every lesson of the course's chapters (variants aside), in chapter order.
+// Every lesson of the course's chapters (variants aside), in chapter order, then the course's.
 std::vector<Found> course_lessons() {
   std::vector<Found> found;
   for (const ChapterInfo& c : chapters())
     if (c.lessons && c.variant_of.empty())
       for (Lesson& l : c.lessons()) found.push_back({&c, std::move(l)});
+  for (Lesson& l : roofline::lessons()) found.push_back({nullptr, std::move(l)});
   return found;
 }
 
@@ -39,8 +42,9 @@ std::string usage() {
   std::string out = "usage: fem_lessons [LESSON [--chapter ID] [options]]\n";
   for (const Found& f : course_lessons())
     out += "  " + f.lesson.name +
-           std::string(std::max<int>(1, 17 - int(f.lesson.name.size())), ' ') + "chapter " +
-           f.chapter->id.substr(0, 2) + ": " + f.lesson.summary + "\n";
+           std::string(std::max<int>(1, 17 - int(f.lesson.name.size())), ' ') +
+           (f.chapter ? "chapter " + f.chapter->id.substr(0, 2) : std::string("the course")) +
+           ": " + f.lesson.summary + "\n";
   return out + "without a lesson: every lesson in turn, with its defaults\n";
 }
 
@@ -60,17 +64,21 @@ std::string command_line(int argc, char** argv) {
 }
 
 // The table as committed data (docs/data/lessons/NAME.json): scripts/lesson_tables.py writes
-// it between the lesson's markers of the chapter's README, and checks that it is there.
-void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo& chapter,
-                const std::string& command, const std::string& table) {
+// it between the lesson's markers of the chapter's README (or the lesson's own page), and
+// checks that it is there. A lesson's numbers, when it leaves them, go in "data".
+void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo* chapter,
+                const std::string& command, const std::string& table, const std::string& data) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  const std::string id = chapter ? chapter->id : "";
+  const std::string readme =
+      !lesson.readme.empty() ? lesson.readme : "chapters/" + id + "/README.md";
   out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
-      << ",\n  \"chapter\": " << json_string(chapter.id)
-      << ",\n  \"readme\": " << json_string("chapters/" + chapter.id + "/README.md")
+      << ",\n  \"chapter\": " << json_string(id) << ",\n  \"readme\": " << json_string(readme)
       << ",\n  \"marker\": " << json_string(lesson.name + "-table")
-      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table)
-      << "\n}\n";
+      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table);
+  if (!data.empty()) out << ",\n  \"data\": " << data;
+  out << "\n}\n";
 }
 
 // Fails before the work when the JSON cannot be written there.
@@ -105,7 +113,8 @@ int run_lesson(const Found& found, int argc, char** argv) {
   ArgParser args(program, found.lesson.summary + ". Prints the lesson's table in Markdown.");
   add_scene_options(args, found.lesson.default_mesh);
   args.option("steps", "N", "measured steps or solves", "50");
-  args.option("chapter", "ID", "also run the lesson's copy in this variant of the chapter", "");
+  if (found.chapter)
+    args.option("chapter", "ID", "also run the lesson's copy in this variant of the chapter", "");
   args.option("readme", "FILE", "also write the table between the lesson's markers in FILE", "");
   args.option("json", "FILE", "also write the table as JSON (docs/data/lessons/NAME.json)", "");
   add_thread_option(args);
@@ -117,7 +126,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
     std::vector<std::pair<const ChapterInfo*, Lesson>> runs = {{found.chapter, found.lesson}};
-    if (const std::string& id = args.get("chapter"); !id.empty()) {
+    if (const std::string id = found.chapter ? args.get("chapter") : ""; !id.empty()) {
       const ChapterInfo& variant = find_chapter(id);
       if (variant.id != found.chapter->id)
         runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
@@ -136,14 +145,16 @@ int run_lesson(const Found& found, int argc, char** argv) {
       std::cout.copyfmt(cout_defaults);
       std::cerr.copyfmt(cerr_defaults);
       if (runs.size() > 1) std::cout << "\n### " << chapter->id << "\n\n";
-      const std::string table = measure(lesson, {args, scene, steps, chapter->id});
+      std::string data;
+      const std::string table =
+          measure(lesson, {args, scene, steps, chapter ? chapter->id : "", &data});
       std::cout << table << std::flush;
       if (!readme.empty()) {
         write_between_markers(readme, lesson.name + "-table", table);
         std::cout << "wrote " << readme << "\n";
       }
       if (!json.empty()) {
-        write_json(json, lesson, *chapter, command_line(argc, argv), table);
+        write_json(json, lesson, chapter, command_line(argc, argv), table, data);
         std::cout << "wrote " << json << "\n";
       }
     }

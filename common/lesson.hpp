@@ -21,6 +21,9 @@ struct LessonRun {
   const Scene& scene;
   int steps;            // measured steps or solves (--steps)
   std::string chapter;  // the chapter (or variant) whose code is measured
+  // Where a lesson may leave its numbers as one JSON value, recorded beside its table as
+  // "data" (the roofline's plot reads them); null when nobody records them.
+  std::string* data = nullptr;
 };
 
 struct Lesson {
@@ -35,6 +38,9 @@ struct Lesson {
   // False: the table is measured on one thread (OpenMP's and Eigen's counts at 1), as the
   // chapters before 09 run; true: at the thread counts the lesson chooses (--threads).
   bool uses_threads = false;
+  // Where the table goes (between its markers): empty for its chapter's README; a lesson of
+  // the whole course (the roofline) names its page.
+  std::string readme = "";
 };
 
 // ---- what the measurements share ----------------------------------------------------------

@@ -51,6 +51,7 @@ class OneThreadStepper final : public Stepper {
   const Eigen::SparseVector<double>& external_forces() const override {
     return inner_->external_forces();
   }
+  const Stepper& inner() const { return *inner_; }
 
  private:
   std::unique_ptr<Stepper> inner_;
@@ -61,6 +62,11 @@ class OneThreadStepper final : public Stepper {
 std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const Scene& scene) {
   if (!stepper || stepper->uses_threads()) return stepper;
   return std::make_unique<OneThreadStepper>(std::move(stepper), scene);
+}
+
+const Stepper& unwrapped(const Stepper& stepper) {
+  const auto* wrapper = dynamic_cast<const OneThreadStepper*>(&stepper);
+  return wrapper ? wrapper->inner() : stepper;
 }
 
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,

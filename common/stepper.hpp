@@ -89,6 +89,9 @@ class Stepper {
 // a single-threaded chapter runs on one thread in every program whatever --threads or
 // OMP_NUM_THREADS say. The registry's make_stepper and ChapterInfo::make return this.
 std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const Scene& scene);
+// The chapter's own stepper inside on_one_thread's wrapper (itself when not wrapped): the
+// roofline lesson reads the data structures it holds.
+const Stepper& unwrapped(const Stepper& stepper);
 
 // Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.
 class PhaseTimer {

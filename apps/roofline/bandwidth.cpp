@@ -1,0 +1,146 @@
+#include "apps/roofline/bandwidth.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <fstream>
+
+#include "apps/roofline/best_rate.hpp"
+
+namespace fem::roofline {
+
+namespace {
+
+std::string read_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+// "48K", "1024K", "32M" as the kernel writes cache sizes.
+std::size_t parse_size(const std::string& text) {
+  if (text.empty()) return 0;
+  std::size_t unit = 1;
+  if (text.back() == 'K') unit = 1024;
+  if (text.back() == 'M') unit = 1024 * 1024;
+  return static_cast<std::size_t>(std::stoull(text)) * unit;
+}
+
+// "0-1", "0,2", "0-3,8-11": how many CPUs the list names.
+int count_cpus(const std::string& list) {
+  int count = 0;
+  std::size_t start = 0;
+  while (start < list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string range = list.substr(start, comma - start);
+    const std::size_t dash = range.find('-');
+    count +=
+        dash == std::string::npos ? 1 : std::stoi(range.substr(dash + 1)) - std::stoi(range) + 1;
+    start = comma + 1;
+  }
+  return std::max(count, 1);
+}
+
+using Packet = Eigen::internal::packet_traits<double>::type;
+constexpr int kLanes = Eigen::internal::packet_traits<double>::size;
+// Independent partial sums: an addition's latency (about 4 cycles) times the two loads a core
+// issues per cycle. With one sum the loop would wait on its own additions and measure the
+// adder's latency, not the cache.
+constexpr int kSums = 8;
+constexpr std::size_t kStride = kSums * kLanes;
+
+// Elements per thread for `bytes`, whole strides of the read kernel, at least one.
+std::size_t elements(std::size_t bytes) {
+  return std::max<std::size_t>(1, bytes / sizeof(double) / kStride) * kStride;
+}
+
+// One pass of the read kernel: Eigen's packets (pload, padd, predux from
+// Eigen/src/Core/GenericPacketMath.h and the target's PacketMath.h), kSums sums in registers.
+double read_pass(const Eigen::VectorXd& a) {
+  using namespace Eigen::internal;
+  Packet sum[kSums];
+  for (Packet& s : sum) s = pset1<Packet>(0.0);
+  const double* data = a.data();
+  for (Eigen::Index i = 0; i < a.size(); i += kStride)
+    for (int k = 0; k < kSums; ++k) sum[k] = padd(sum[k], pload<Packet>(data + i + k * kLanes));
+  for (int k = 1; k < kSums; ++k) sum[0] = padd(sum[0], sum[k]);
+  return predux(sum[0]);
+}
+
+}  // namespace
+
+std::string CacheLevel::name() const { return "L" + std::to_string(level); }
+
+std::vector<CacheLevel> cache_levels() {
+  std::vector<CacheLevel> levels;
+  const std::string root = "/sys/devices/system/cpu/cpu0/cache/index";
+  for (int index = 0; index < 16; ++index) {
+    const std::string dir = root + std::to_string(index) + "/";
+    const std::string type = read_line(dir + "type");
+    if (type.empty()) break;
+    if (type == "Instruction") continue;
+    CacheLevel c;
+    c.level = std::atoi(read_line(dir + "level").c_str());
+    c.bytes = parse_size(read_line(dir + "size"));
+    c.shared_by = count_cpus(read_line(dir + "shared_cpu_list"));
+    if (c.level > 0 && c.bytes > 0) levels.push_back(c);
+  }
+  std::sort(levels.begin(), levels.end(),
+            [](const CacheLevel& a, const CacheLevel& b) { return a.level < b.level; });
+  return levels;
+}
+
+std::vector<CacheLevel> fallback_levels() {
+  return {
+      {1, std::size_t(32) << 10, 1}, {2, std::size_t(1) << 20, 1}, {3, std::size_t(32) << 20, 64}};
+}
+
+std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads) {
+  std::vector<MemoryLevel> levels;
+  std::size_t largest = 0;
+  for (const CacheLevel& c : caches) {
+    // A shared cache holds every thread's data: each thread gets its share.
+    const int sharing = std::min(std::max(threads, 1), c.shared_by);
+    const std::size_t per_thread = c.bytes / static_cast<std::size_t>(sharing);
+    levels.push_back({c.name(), per_thread, per_thread / 2});
+    largest = std::max(largest, c.bytes);
+  }
+  const std::size_t memory = std::max<std::size_t>(largest, std::size_t(8) << 20) * 4;
+  levels.push_back({"memory", 0, memory / static_cast<std::size_t>(std::max(threads, 1))});
+  return levels;
+}
+
+double read_bandwidth(std::size_t bytes, int threads, double seconds) {
+  const std::size_t n = elements(bytes);
+  return best_rate(
+      threads, seconds, double(n * sizeof(double)),
+      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
+      [](const Eigen::VectorXd& a) { return read_pass(a); });
+}
+
+double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds) {
+  const std::size_t n = elements(bytes);
+  return best_rate(
+      threads, seconds, double(n * sizeof(double)),
+      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
+      [](const Eigen::VectorXd& a) { return a.sum(); });
+}
+
+double triad_bandwidth(std::size_t bytes, int threads, double seconds) {
+  struct Arrays {
+    Eigen::VectorXd a, b, c;
+  };
+  const Eigen::Index n = Eigen::Index(elements(bytes));
+  return best_rate(
+      threads, seconds, 3.0 * double(n) * sizeof(double),
+      [n] {
+        return Arrays{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Constant(n, 1.0),
+                      Eigen::VectorXd::Constant(n, 2.0)};
+      },
+      [](Arrays& s) {
+        s.a.noalias() = s.b + 0.5 * s.c;
+        return s.a[0];
+      });
+}
+
+}  // namespace fem::roofline

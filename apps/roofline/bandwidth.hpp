@@ -1,0 +1,55 @@
+// The roofline's bandwidth roofs: how many bytes per second this machine reads from each level
+// of its memory hierarchy, on one thread and on several (Williams, Waterman & Patterson,
+// "Roofline: an insightful visual performance model for multicore architectures", CACM 52(4),
+// 2009). Measured, not looked up: the vendor's number is a bus's width times its clock, which
+// no loop reaches, and STREAM's triad (McCalpin 1995) mixes reads and writes, while every pass
+// of a step reads far more than it writes (the matrix, the element data).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace fem::roofline {
+
+// One data or unified cache as the kernel reports it (/sys/devices/system/cpu/cpu0/cache).
+struct CacheLevel {
+  int level = 0;             // 1, 2, 3
+  std::size_t bytes = 0;     // capacity of one instance
+  int shared_by = 1;         // hardware threads that share one instance
+  std::string name() const;  // "L1", "L2", ...
+};
+
+// The data caches of cpu0, innermost first; empty where the system does not say (then the
+// lesson sweeps sizes instead: fallback_levels).
+std::vector<CacheLevel> cache_levels();
+// 32 KiB, 1 MiB, 32 MiB: a guess that stands in where cache_levels() is empty.
+std::vector<CacheLevel> fallback_levels();
+
+// Where the data of a roof lives: a cache level, or memory (level 0 after the caches).
+struct MemoryLevel {
+  std::string name;             // "L1", ..., "memory"
+  std::size_t capacity = 0;     // bytes one thread may use and still fit (0: memory, unbounded)
+  std::size_t working_set = 0;  // the array each thread reads to measure it
+};
+
+// The levels with the working set each measurement uses: half of a private cache (so that
+// the code and the stack do not push the array out), half of a shared cache split between
+// `threads`, and memory at four times the largest cache.
+std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads);
+
+// The best read bandwidth (bytes/s) of `threads` threads, each summing its own array of
+// `bytes` over and over for about `seconds`: the best of several timed repetitions, since a
+// roof is what the machine can do, and a slower repetition only says something else ran.
+double read_bandwidth(std::size_t bytes, int threads, double seconds);
+
+// The same read, by another kernel: Eigen's own sum (DenseBase::sum, Eigen/src/Core/Redux.h)
+// of a VectorXd per thread. The roof's second, independent measurement.
+double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds);
+
+// STREAM's triad a = b + s c on three arrays of `bytes` each, counted as STREAM counts it
+// (24 bytes per element: two reads, one write; the cache line the write first reads is not
+// counted). What STREAM would report as the machine's bandwidth.
+double triad_bandwidth(std::size_t bytes, int threads, double seconds);
+
+}  // namespace fem::roofline
