@@ -324,7 +324,7 @@ threads() {
   counts=$(seq -s, 1 "$(nproc)")
   log "chapter 09 at $counts threads (chapter 08 beside it, one thread) on the poster-sized mesh"
   "$BUILD_DIR/fem_bench" --chapters 08,09 --threads "$counts" --no-solvers \
-    --json results/threads.json "$@"
+    --json results/threads.json --replace "$@"
   "$VENV/bin/python" scripts/plot_results.py --threads results/threads.json --out results
 }
 

@@ -48,7 +48,7 @@ def run_point(args, mesh, e, json_path):
     """One fem_bench run; its progress lines go through, indented."""
     cmd = [args.bench, "--mesh", str(mesh), "--E", repr(e), "--scene", args.scene,
            "--chapters", args.chapters, "--steps", str(args.steps), "--warmup", str(args.warmup),
-           "--json", str(json_path)] + (["--no-solvers"] if args.no_solvers else [])
+           "--json", str(json_path), "--replace"] + (["--no-solvers"] if args.no_solvers else [])
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     for line in proc.stdout:
         if line.startswith("  step") or "warning" in line or "solve table" in line:

@@ -34,7 +34,7 @@ def registry_chapters(bench, tmp):
     """The chapters fem_bench runs with --chapters all: one step each on the test mesh."""
     out = tmp / "registry.json"
     subprocess.run([bench, "--mesh", str(ROOT / "meshes" / "test_beam.msh"), "--steps", "1", "--warmup", "1",
-                    "--no-solvers", "--json", str(out)], check=True, capture_output=True)
+                    "--no-solvers", "--json", str(out), "--replace"], check=True, capture_output=True)
     return [c["chapter"] for c in json.loads(out.read_text())["chapters"]]
 
 
