@@ -84,13 +84,24 @@ def self_test():
     assert tables_outside_markers("```\n" + table.format("1.5") + "```\n") == []
 
 
+# A lesson, not a lab notebook: the words a page may take (`wc -w`), generated tables included.
+WORD_LIMITS = {"README.md": 2500, **{f"chapters/{n}_*/README.md": 3000
+                                     for n in ("08", "09", "10", "11", "12")}}
+
+
+def too_long(root):
+    return [f"{path.relative_to(root)}: {words} words, over its limit of {limit}"
+            for pattern, limit in WORD_LIMITS.items() for path in sorted(root.glob(pattern))
+            if (words := len(path.read_text().split())) > limit and not (path.parent / "variant_of").exists()]
+
+
 def main():
     self_test()
     root = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT
     problems = [f"{path.relative_to(root)}:{line}: a table with a measured number ({number}) "
                 f"outside the generated markers"
                 for path in doc_files(root) if path.exists()
-                for line, number in tables_outside_markers(path.read_text())]
+                for line, number in tables_outside_markers(path.read_text())] + too_long(root)
     for p in problems:
         print("FAIL", p)
     print(f"{len(problems)} tables with measured numbers outside the generated markers "
