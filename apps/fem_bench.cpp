@@ -26,6 +26,7 @@
 #include "common/cli.hpp"
 #include "common/json.hpp"
 #include "common/machine_load.hpp"
+#include "common/machine_record.hpp"
 #include "common/threads.hpp"
 
 namespace {
@@ -429,7 +430,8 @@ void write_json(const std::string& path, const Scene& scene, const SolverSetting
       << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
-      << ", \"threads\": " << hardware_threads() << ", " << load.json_fields() << "},\n";
+      << ", \"threads\": " << hardware_threads() << ", " << load.json_fields() << ", "
+      << machine_record_json(machine_record()) << "},\n";
   out << "  \"openmp\": " << (openmp_enabled() ? "true" : "false") << ",\n";
   out << "  " << source_state_json(source) << ",\n";
   out << "  \"chapters\": [\n";

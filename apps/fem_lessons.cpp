@@ -15,6 +15,7 @@
 #include "common/json.hpp"
 #include "common/lesson.hpp"
 #include "common/machine_load.hpp"
+#include "common/machine_record.hpp"
 #include "common/threads.hpp"
 
 namespace {
@@ -70,7 +71,7 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
       << ",\n  \"readme\": " << json_string("chapters/" + chapter.id + "/README.md")
       << ",\n  \"marker\": " << json_string(lesson.name + "-table")
       << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table)
-      << "\n}\n";
+      << ",\n  \"machine\": {" << machine_record_json(machine_record()) << "}\n}\n";
 }
 
 // Fails before the work when the JSON cannot be written there.

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "common/build_info.hpp"
+#include "common/machine_record.hpp"
 
 namespace fem {
 
@@ -30,7 +31,8 @@ std::string mesh_name(const Scene& scene) {
 
 std::string measured_on() {
   const BuildInfo info = build_info();
-  return cpu_model() + ", " + info.compiler + ", `" + info.flags + "`";
+  return cpu_model() + ", " + machine_summary(machine_record()) + ", " + info.compiler + ", `" +
+         info.flags + "`";
 }
 
 }  // namespace fem
