@@ -12,6 +12,9 @@ VENV="$ROOT/.venv"
 
 APT_PACKAGES=(
   build-essential cmake ninja-build git python3 python3-venv
+  # the compiler cache: a build folder, a copy of the repository (the coursework tests) or
+  # another preset compiles only what it compiles differently (CMakeLists.txt)
+  ccache
   libeigen3-dev catch2
   # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
   libsuitesparse-dev
@@ -49,6 +52,10 @@ commands:
              variant's sources against the run's record, its diff, its tests, the plots
              regenerated from the JSON; docs/coursework.md)
   plots      remake the plots of a run folder from its bench.json: ./tutorial.sh plots DIR
+  compare    a run beside another (default: the committed docs/data/bench.json): each chapter's
+             speedup over chapter 01 per phase in both, the differences beyond the runs' spread
+             marked, what differs in the two records (instruction set, cores, compiler, load),
+             and DIR/compare.png: ./tutorial.sh compare RUN [REFERENCE]
   variant    copy a chapter under a new name to change it and measure it against the
              original: ./tutorial.sh variant 06 my_fused_updates (chapters/README.md)
   scaling    build and run the chapters over the beam series up to about 100,000 nodes (large
@@ -298,6 +305,12 @@ plots() {
   "$VENV/bin/python" scripts/plot_results.py "$json" --out "$out"
 }
 
+compare() {
+  [ $# -ge 1 ] && [ $# -le 2 ] || { echo "usage: ./tutorial.sh compare RUN [REFERENCE] (run folders or bench.json files)" >&2; exit 2; }
+  setup_python
+  "$VENV/bin/python" scripts/compare_runs.py "$@"
+}
+
 variant() {
   [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
   setup_python
@@ -461,6 +474,7 @@ main() {
     test) run_tests "$@" ;;
     bench) bench "$@" ;;
     plots) plots "$@" ;;
+    compare) compare "$@" ;;
     variant) variant "$@" ;;
     diff) diff_variant "$@" ;;
     handin-check) handin_check "$@" ;;

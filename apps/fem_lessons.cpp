@@ -17,6 +17,7 @@
 #include "common/json.hpp"
 #include "common/lesson.hpp"
 #include "common/machine_load.hpp"
+#include "common/machine_record.hpp"
 #include "common/threads.hpp"
 
 namespace {
@@ -76,9 +77,16 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
   out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
       << ",\n  \"chapter\": " << json_string(id) << ",\n  \"readme\": " << json_string(readme)
       << ",\n  \"marker\": " << json_string(lesson.name + "-table")
-      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table);
-  if (!data.empty()) out << ",\n  \"data\": " << data;
-  out << "\n}\n";
+      << ",
+  \"command\": " << json_string(command) << ",
+  \"table\": " << json_string(table)
+      << ",
+  \"machine\": {" << machine_record_json(machine_record()) << "}";
+  if (!data.empty()) out << ",
+  \"data\": " << data;
+  out << "
+}
+";
 }
 
 // Fails before the work when the JSON cannot be written there.

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/build_info.hpp"
+#include "common/machine_record.hpp"
 #include "common/mesh.hpp"
 
 namespace fem {
@@ -32,7 +33,8 @@ std::string mesh_name(const Scene& scene) {
 
 std::string measured_on() {
   const BuildInfo info = build_info();
-  return cpu_model() + ", " + info.compiler + ", `" + info.flags + "`";
+  return cpu_model() + ", " + machine_summary(machine_record()) + ", " + info.compiler + ", `" +
+         info.flags + "`";
 }
 
 std::vector<Scene> more_meshes(const LessonRun& run) {

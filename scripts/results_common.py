@@ -116,6 +116,7 @@ def validate_bench(data):
             problems.append(f"machine.busy: expected a bool, got {machine['busy']!r}")
         if machine.get("other_cpus") is not None:
             need(machine, "other_cpus", float, "machine")
+        problems += validate_machine_record(machine)
     uncommitted = data.get("uncommitted")
     if uncommitted is not None and not (isinstance(uncommitted, list) and
                                         all(isinstance(f, str) for f in uncommitted)):
@@ -152,6 +153,54 @@ def validate_bench(data):
             if isinstance(s, dict) and key in s:
                 need(s, key, float, where)
     return problems
+
+
+# The machine record (common/machine_record.hpp): absent in runs recorded before it existed,
+# whole and typed when there.
+MACHINE_RECORD = {"vendor": str, "family": int, "model": int, "model_name": str, "isa_build": str,
+                  "isa_cpu": str, "features_build": list, "features_cpu": list, "cores": int,
+                  "hardware_threads": int, "caches": list, "memory_bytes": int}
+ISA_NAMES = ("SSE2", "SSE4.2", "AVX", "AVX2", "AVX-512")
+
+
+def validate_machine_record(machine):
+    if not any(key in machine for key in MACHINE_RECORD):
+        return []
+    problems = []
+    for key, kind in MACHINE_RECORD.items():
+        value = machine.get(key)
+        if not isinstance(value, kind) or isinstance(value, bool):
+            problems.append(f"machine.{key}: expected {kind.__name__}, got {value!r}")
+    for key in ("isa_build", "isa_cpu"):
+        if isinstance(machine.get(key), str) and machine[key] not in ISA_NAMES + ("unknown",):
+            problems.append(f"machine.{key}: expected one of {', '.join(ISA_NAMES)}, got {machine[key]!r}")
+    for i, c in enumerate(machine.get("caches") or []):
+        if not isinstance(c, dict) or not all(isinstance(c.get(k), t) for k, t in
+                                              (("level", int), ("type", str), ("bytes", int), ("shared_by", int))):
+            problems.append(f"machine.caches[{i}]: expected level, type, bytes, shared_by, got {c!r}")
+    return problems
+
+
+def machine_summary(machine):
+    """The instruction set and the cores of a run, for a caption or a footnote: "AVX2 build on
+    an AVX-512 CPU, 2 cores / 2 threads"; what older runs recorded otherwise."""
+    m = machine
+    if "isa_build" not in m:
+        return f"{m.get('threads', '?')} threads, instruction set not recorded"
+    cores = m["cores"] if m["cores"] >= 0 else "?"
+    return f"{m['isa_build']} build on an {m['isa_cpu']} CPU, {cores} cores / {m['hardware_threads']} threads"
+
+
+def cache_summary(machine):
+    """"L1d 48 KiB, L2 1 MiB, L3 32 MiB" from a machine record ("" when not recorded)."""
+    parts = []
+    for c in machine.get("caches", []):
+        if c["type"] == "Instruction":
+            continue
+        size = c["bytes"] >> 10
+        text = f"{size >> 10} MiB" if size >= 1024 and size % 1024 == 0 else f"{size} KiB"
+        parts.append(f"L{c['level']}{'d' if c['type'] == 'Data' else ''} {text}")
+    return ", ".join(parts)
 
 
 def validate_scaling(data):
@@ -220,7 +269,7 @@ def footer(data):
              f"{data['scene']}, {data.get('steps', '?')} steps, " if mesh else f"{data['scene']}, ")
     changed = uncommitted_summary(data)
     busy = busy_note(data)
-    return (f"{where}CG tol {data['cg_tolerance']:g} | {m['cpu']} | "
+    return (f"{where}CG tol {data['cg_tolerance']:g} | {m['cpu']}, {machine_summary(m)} | "
             f"{b['compiler']} {b['flags']} | Eigen {b['eigen']} | commit {data.get('commit', '?')}"
             + (f" + uncommitted {changed}" if changed else "") + (f"\n{busy}" if busy else ""))
 

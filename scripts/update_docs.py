@@ -28,7 +28,8 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (ALL_PHASES, BASELINE, PHASE_LABELS, PHASES, POSTER_SOLVE_MS,  # noqa: E402
-                            POSTER_SPEEDUPS, ResultsError, chapter_dir, die, load_checked)
+                            POSTER_SPEEDUPS, ResultsError, cache_summary, chapter_dir, die,
+                            load_checked, machine_summary)
 import regimes_common  # noqa: E402
 from results_common import load  # noqa: E402
 
@@ -54,13 +55,15 @@ def chapters_by_name(data):
 
 def machine_table(data):
     b, m, mesh = data["build"], data["machine"], data["mesh"]
-    rows = [("CPU", f"{m['cpu']} ({m.get('threads', '?')} threads)"),
+    rows = [("CPU", f"{m['cpu']} ({machine_summary(m)})"),
             ("compiler", b["compiler"]), ("flags", f"`{b['flags']}`"),
             ("build type", b["build_type"]), ("Eigen", b["eigen"]), ("commit", data["commit"]),
             ("mesh", f"{mesh['file']}: {mesh['nodes']} nodes, {mesh['tets']} tets"),
             ("scene", data["scene"]),
             ("steps", f"{data['warmup_steps']} warm-up + {data['steps']} measured, dt = {data['dt']:g} s"),
             ("CG", f"relative tolerance {data['cg_tolerance']:g}, at most {data['cg_max_iterations']} iterations")]
+    if cache_summary(m):
+        rows.append(("caches, memory", f"{cache_summary(m)}; {m['memory_bytes'] / 2**30:.0f} GiB"))
     if m.get("other_cpus") is not None:
         rows.append(("machine load", f"other processes used {m['other_cpus']:.2g} of {m.get('threads', '?')} "
                                      f"cores during the run" + (" (**busy**: the times are not the code's alone)"
@@ -210,7 +213,9 @@ def viewer_table(viewer):
     return (table(["chapter", "frames/s", "mean step (ms)"], rows) +
             f"\nMeasured by `./tutorial.sh viewer-bench`: {mesh} ({first['nodes']} nodes), "
             f"{first['width']}x{first['height']}, {viewer['frames']} frames a run, one step per frame, "
-            f"renderer {first['renderer']}, {first['cpu']}, {first['compiler']} `{first['flags']}`, "
+            f"renderer {first['renderer']}, {first['cpu']}"
+            + (f" ({machine_summary(first['machine'])})" if "machine" in first else "") +
+            f", {first['compiler']} `{first['flags']}`, "
             f"commit {viewer['commit']}.\n")
 
 
@@ -228,7 +233,8 @@ def headline(data):
             "![Speedup per phase over chapter 01, beside the poster's](docs/images/speedup.png)\n\n" +
             table(["chapter", "step (ms, median)", "speedup over 01", "allocations per step"], rows) +
             f"\nMeasured by `./tutorial.sh bench` on {mesh['file']} ({mesh['nodes']} nodes, "
-            f"{mesh['tets']} tets), {data['scene']} scene, {data['machine']['cpu']}, "
+            f"{mesh['tets']} tets), {data['scene']} scene, {data['machine']['cpu']} "
+            f"({machine_summary(data['machine'])}), "
             f"{b['compiler']} `{b['flags']}`, commit {data['commit']}.\n")
 
 
@@ -423,9 +429,9 @@ def threads_table(threads, bench=None):
     b, m = threads["build"], threads["machine"]
     return (table(header, rows) +
             f"\n{threads['mesh']['file']}, {threads['scene']}, {threads['steps']} steps, one interleaved run "
-            f"(`./tutorial.sh threads`) on {m['cpu']} with {m.get('threads', '?')} hardware threads"
-            + (f" (1-minute load average {m['load_average'][0]:.1f} at the start, "
-               f"{m['load_average'][1]:.1f} at the end)" if "load_average" in m else "") + ", "
+            f"(`./tutorial.sh threads`) on {m['cpu']} ({machine_summary(m)})"
+            + (f", 1-minute load average {m['load_average'][0]:.1f} at the start, "
+               f"{m['load_average'][1]:.1f} at the end" if "load_average" in m else "") + ", "
             f"{b['compiler']} `{b['flags']}`, commit {threads['commit']}."
             + (f" A run of its own, not the benchmark run of commit {bench['commit']} of the tables above: "
                "compare the rows of one table, not milliseconds across tables."

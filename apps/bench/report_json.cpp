@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/json.hpp"
+#include "common/machine_record.hpp"
 #include "common/threads.hpp"
 
 namespace fem::bench {
@@ -49,7 +50,8 @@ void write_run(std::ostream& out, const Scene& scene, const BenchOptions& option
       << ", \"build_type\": " << json_string(b.build_type)
       << ", \"eigen\": " << json_string(b.eigen) << "},\n";
   out << "  \"machine\": {\"cpu\": " << json_string(cpu_model())
-      << ", \"threads\": " << hardware_threads() << ", " << load.json_fields() << "},\n";
+      << ", \"threads\": " << hardware_threads() << ", " << load.json_fields() << ", "
+      << machine_record_json(machine_record()) << "},\n";
   out << "  \"openmp\": " << (openmp_enabled() ? "true" : "false") << ",\n";
   out << "  " << source_state_json(source) << ",\n";
 }

@@ -18,6 +18,7 @@
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
+#include "common/machine_record.hpp"
 #include "common/threads.hpp"
 
 namespace fv = fem::viewer;
@@ -114,7 +115,8 @@ void write_report(const std::string& path, const RunRecord& r, const fv::Session
       << ",\n  \"paused\": " << (r.paused ? "true" : "false") << ",\n  \"width\": " << r.width
       << ",\n  \"height\": " << r.height
       << ",\n  \"renderer\": " << fem::json_string(renderer ? renderer : "unknown")
-      << ",\n  \"cpu\": " << fem::json_string(fem::cpu_model())
+      << ",\n  \"cpu\": " << fem::json_string(fem::cpu_model()) << ",\n  \"machine\": {"
+      << fem::machine_record_json(fem::machine_record()) << "}"
       << ",\n  \"compiler\": " << fem::json_string(build.compiler)
       << ",\n  \"flags\": " << fem::json_string(build.flags) << ",\n  \"frames\": " << r.frames
       << ",\n  \"seconds\": " << r.seconds

@@ -1,0 +1,206 @@
+#include "common/machine_record.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <utility>
+
+#include "common/json.hpp"
+
+namespace fem {
+namespace {
+
+// The vector extensions a ratio between chapters can depend on (chapter 12's lanes, Eigen's
+// packet size: Eigen/src/Core/util/ConfigureVectorization.h picks AVX-512, AVX or SSE from
+// the same macros), named as /proc/cpuinfo's flags name them, with the macro a compiler
+// defines when it targets the extension.
+struct Feature {
+  const char* flag;
+  bool built;
+};
+constexpr Feature kVectorFeatures[] = {
+#ifdef __SSE4_2__
+    {"sse4_2", true},
+#else
+    {"sse4_2", false},
+#endif
+#ifdef __AVX__
+    {"avx", true},
+#else
+    {"avx", false},
+#endif
+#ifdef __AVX2__
+    {"avx2", true},
+#else
+    {"avx2", false},
+#endif
+#ifdef __FMA__
+    {"fma", true},
+#else
+    {"fma", false},
+#endif
+#ifdef __AVX512F__
+    {"avx512f", true},
+#else
+    {"avx512f", false},
+#endif
+#ifdef __AVX512VL__
+    {"avx512vl", true},
+#else
+    {"avx512vl", false},
+#endif
+};
+
+std::string widest(const std::vector<std::string>& features) {
+  const std::set<std::string> has(features.begin(), features.end());
+  for (const auto& [flag, name] :
+       {std::pair{"avx512f", "AVX-512"}, {"avx2", "AVX2"}, {"avx", "AVX"}, {"sse4_2", "SSE4.2"}})
+    if (has.count(flag)) return name;
+  return "SSE2";
+}
+
+std::string value_after_colon(const std::string& line) {
+  const auto colon = line.find(':');
+  if (colon == std::string::npos) return "";
+  const auto start = line.find_first_not_of(" \t", colon + 1);
+  return start == std::string::npos ? "" : line.substr(start);
+}
+
+bool starts_with(const std::string& line, const std::string& key) {
+  return line.rfind(key, 0) == 0 && line.find(':') != std::string::npos &&
+         line.find_first_not_of(" \t", key.size()) == line.find(':');
+}
+
+// /proc/cpuinfo: the first processor's identity and flags, and the (package, core) pairs of
+// all of them, which count the physical cores.
+void read_cpuinfo(MachineRecord& m) {
+  std::ifstream in("/proc/cpuinfo");
+  std::set<std::pair<std::string, std::string>> cores;
+  std::string line, package, flags;
+  while (std::getline(in, line)) {
+    const std::string value = value_after_colon(line);
+    if (starts_with(line, "vendor_id") && m.vendor == "unknown") m.vendor = value;
+    if (starts_with(line, "cpu family") && m.family < 0) m.family = std::stoi(value);
+    if (starts_with(line, "model") && m.model < 0) m.model = std::stoi(value);
+    if (starts_with(line, "model name") && m.model_name == "unknown") m.model_name = value;
+    if (starts_with(line, "flags") && flags.empty()) flags = " " + value + " ";
+    if (starts_with(line, "physical id")) package = value;
+    if (starts_with(line, "core id")) cores.insert({package, value});
+  }
+  for (const Feature& f : kVectorFeatures)
+    if (flags.find(" " + std::string(f.flag) + " ") != std::string::npos)
+      m.features_cpu.push_back(f.flag);
+  if (!cores.empty()) m.cores = static_cast<int>(cores.size());
+}
+
+std::string read_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+// "32K", "1024K", "32M" (sysfs cache sizes) in bytes.
+long long size_in_bytes(const std::string& text) {
+  if (text.empty()) return 0;
+  const long long n = std::stoll(text);
+  const char unit = text.back();
+  return unit == 'K' ? n << 10 : unit == 'M' ? n << 20 : unit == 'G' ? n << 30 : n;
+}
+
+// "0-1,4" (a cpu list) -> 3.
+int cpus_in_list(const std::string& list) {
+  int count = 0;
+  std::istringstream ranges(list);
+  std::string range;
+  while (std::getline(ranges, range, ',')) {
+    const auto dash = range.find('-');
+    count += dash == std::string::npos
+                 ? 1
+                 : std::stoi(range.substr(dash + 1)) - std::stoi(range.substr(0, dash)) + 1;
+  }
+  return count;
+}
+
+void read_caches(MachineRecord& m) {
+  for (int i = 0;; ++i) {
+    const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(i) + "/";
+    const std::string level = read_line(dir + "level");
+    if (level.empty()) return;
+    CacheLevel c;
+    c.level = std::stoi(level);
+    c.type = read_line(dir + "type");
+    c.bytes = size_in_bytes(read_line(dir + "size"));
+    const std::string shared = read_line(dir + "shared_cpu_list");
+    c.shared_by = shared.empty() ? 1 : cpus_in_list(shared);
+    m.caches.push_back(c);
+  }
+}
+
+long long memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string line;
+  while (std::getline(in, line))
+    if (starts_with(line, "MemTotal")) return std::stoll(value_after_colon(line)) << 10;  // kB
+  return -1;
+}
+
+std::string json_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + json_string(items[i]);
+  return out + "]";
+}
+
+std::string caches_json(const std::vector<CacheLevel>& caches) {
+  std::ostringstream out;
+  out << "[";
+  for (std::size_t i = 0; i < caches.size(); ++i)
+    out << (i ? ", " : "") << "{\"level\": " << caches[i].level
+        << ", \"type\": " << json_string(caches[i].type) << ", \"bytes\": " << caches[i].bytes
+        << ", \"shared_by\": " << caches[i].shared_by << "}";
+  out << "]";
+  return out.str();
+}
+
+}  // namespace
+
+MachineRecord machine_record() {
+  MachineRecord m;
+  try {
+    read_cpuinfo(m);
+    read_caches(m);
+    m.memory_bytes = memory_bytes();
+  } catch (const std::exception&) {
+    // A kernel that words a field otherwise leaves it unknown; the record is a note, not input.
+  }
+  for (const Feature& f : kVectorFeatures)
+    if (f.built) m.features_build.push_back(f.flag);
+  m.isa_build = widest(m.features_build);
+  m.isa_cpu = m.features_cpu.empty() && m.vendor == "unknown" ? "unknown" : widest(m.features_cpu);
+  m.hardware_threads = std::thread::hardware_concurrency();
+  return m;
+}
+
+std::string machine_record_json(const MachineRecord& m) {
+  std::ostringstream out;
+  out << "\"vendor\": " << json_string(m.vendor) << ", \"family\": " << m.family
+      << ", \"model\": " << m.model << ", \"model_name\": " << json_string(m.model_name)
+      << ", \"isa_build\": " << json_string(m.isa_build)
+      << ", \"isa_cpu\": " << json_string(m.isa_cpu)
+      << ", \"features_build\": " << json_list(m.features_build)
+      << ", \"features_cpu\": " << json_list(m.features_cpu) << ", \"cores\": " << m.cores
+      << ", \"hardware_threads\": " << m.hardware_threads
+      << ", \"caches\": " << caches_json(m.caches) << ", \"memory_bytes\": " << m.memory_bytes;
+  return out.str();
+}
+
+std::string machine_summary(const MachineRecord& m) {
+  const auto count = [](long long n, const std::string& what) {
+    return (n < 0 ? std::string("?") : std::to_string(n)) + " " + what + (n == 1 ? "" : "s");
+  };
+  return m.isa_build + " build on an " + m.isa_cpu + " CPU (" + count(m.cores, "core") + ", " +
+         count(m.hardware_threads, "hardware thread") + ")";
+}
+
+}  // namespace fem
