@@ -77,16 +77,10 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
   out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
       << ",\n  \"chapter\": " << json_string(id) << ",\n  \"readme\": " << json_string(readme)
       << ",\n  \"marker\": " << json_string(lesson.name + "-table")
-      << ",
-  \"command\": " << json_string(command) << ",
-  \"table\": " << json_string(table)
-      << ",
-  \"machine\": {" << machine_record_json(machine_record()) << "}";
-  if (!data.empty()) out << ",
-  \"data\": " << data;
-  out << "
-}
-";
+      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table)
+      << ",\n  \"machine\": {" << machine_record_json(machine_record()) << "}";
+  if (!data.empty()) out << ",\n  \"data\": " << data;
+  out << "\n}\n";
 }
 
 // Fails before the work when the JSON cannot be written there.
