@@ -15,6 +15,17 @@
 
 namespace fem::test {
 
+// A soak's steps: under the sanitizers (FEM_SANITIZE), whose instrumentation makes a step
+// ten times slower or more, a fifth of them: the same checks, within CI's time. The soaks'
+// assertions scale with the steps (refreshes per step, energy against the first tenth).
+inline int soak_steps(int steps) {
+#ifdef FEM_SANITIZED
+  return steps / 5;
+#else
+  return steps;
+#endif
+}
+
 inline std::string mesh_path(const std::string& file) { return source_dir() + "/meshes/" + file; }
 
 // The small committed test mesh: a 1 x 0.1 x 0.1 beam, at most 300 nodes.

@@ -204,7 +204,7 @@ SoakResult soak(const std::string& chapter, const Scene& scene, int threads, int
 TEST_CASE("ch09: soak, thousands of steps under a random mouse spring, chapters 07 on",
           "[ch09][soak]") {
   const Scene scene = test::test_scene("cantilever");
-  const int steps = 3000;
+  const int steps = test::soak_steps(3000);
   std::vector<std::pair<std::string, int>> runs = {{"07", 1}, {"08", 1}, {"09", 1}};
   if (openmp_enabled()) runs.push_back({"09", 2});
   std::vector<SoakResult> results;

@@ -305,7 +305,7 @@ Soak soak(const Scene& scene, int threads, int steps) {
 TEST_CASE("ch10: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
           "[ch10][soak]") {
   const Scene scene = test::test_scene("cantilever");
-  const int steps = 3000;
+  const int steps = test::soak_steps(3000);
   std::vector<Soak> runs;
   for (const int threads : openmp_enabled() ? std::vector<int>{1, 2} : std::vector<int>{1}) {
     runs.push_back(soak(scene, threads, steps));
