@@ -17,7 +17,7 @@ namespace fem::test {
 
 // A soak's steps: under the sanitizers (FEM_SANITIZE), whose instrumentation makes a step
 // ten times slower or more, a fifth of them: the same checks, within CI's time. The soaks'
-// assertions scale with the steps (refreshes per step, energy against the first tenth).
+// assertions scale with the steps (refreshes per step) or read a fixed start (energy).
 inline int soak_steps(int steps) {
 #ifdef FEM_SANITIZED
   return steps / 5;
