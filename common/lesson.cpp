@@ -49,4 +49,19 @@ std::vector<Scene> more_meshes(const LessonRun& run) {
   return scenes;
 }
 
+std::string on_every_mesh(const LessonRun& run,
+                          const std::function<std::string(const LessonRun&)>& table,
+                          const std::string& separator) {
+  const std::vector<Scene> scenes = more_meshes(run);
+  std::string tables = table(run);
+  for (const Scene& scene : scenes)
+    tables += separator + table({run.args, scene, run.steps, run.chapter});
+  return tables;
+}
+
+void step_progress(const std::string& name, int k, int total, int every) {
+  if (k % every == 0)
+    progress(name + ": step " + std::to_string(k + 1) + " of " + std::to_string(total));
+}
+
 }  // namespace fem

@@ -71,6 +71,14 @@ std::string measured_on();
 // so that a bad path fails at once.
 std::vector<Scene> more_meshes(const LessonRun& run);
 
+// table(run), then table on each of more_meshes(run), each after `separator`.
+std::string on_every_mesh(const LessonRun& run,
+                          const std::function<std::string(const LessonRun&)>& table,
+                          const std::string& separator = "\n");
+
+// "name: step k + 1 of total" every `every` steps of a lesson's loop (progress()).
+void step_progress(const std::string& name, int k, int total, int every);
+
 // ---- definitions of the templates -----------------------------------------------------
 
 template <class F>

@@ -204,25 +204,13 @@ void ThreadsStepper::element_pass_gather(const State& state) {
 }
 
 void ThreadsStepper::element_pass_colouring(const State& state) {
-  long long fallbacks = 0;
-  run_parallel([&] {
+  elements_.end_pass(for_coloured_groups([&](int first, int last, long long& fallbacks) {
     ch08::ElementTerms terms;
-    long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
-    for (int colour = 0; colour < colours(); ++colour) {
-      // The barrier at the end of each loop orders the colours: no two threads ever add
-      // into the same node's blocks at the same time.
-      for (const int k : StaticShare(colour_start_[colour], colour_start_[colour + 1])) {
-        const int group = colour_order_[k];
-        const int last = std::min(static_cast<int>(model_.tets.size()), (group + 1) * group_);
-        for (int e = group * group_; e < last; ++e) {
-          elements_.terms(e, model_.tets[e], state, my_fallbacks, terms);
-          ch08::scatter(model_.tets[e], index_.element[e], terms, A_, b_);
-        }
-      }
+    for (int e = first; e < last; ++e) {
+      elements_.terms(e, model_.tets[e], state, fallbacks, terms);
+      ch08::scatter(model_.tets[e], index_.element[e], terms, A_, b_);
     }
-    add_count(fallbacks, my_fallbacks);
-  });
-  elements_.end_pass(fallbacks);
+  }));
 }
 
 void ThreadsStepper::solve() {

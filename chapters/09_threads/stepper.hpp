@@ -7,12 +7,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
 #include "chapters/08_element_kernels/element_kernels.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/09_threads/adaptive_team.hpp"
+#include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
 #include "common/model.hpp"
 #include "common/stepper.hpp"
@@ -57,12 +59,12 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // Colours groups of `group` consecutive elements (kGroup by default): on a mesh whose
   // elements come sorted along it, long groups are slabs, and fewer colours.
   void colour_element_groups(int group);
-  // The colouring, for a stepper that computes a group's elements its own way (several at a
-  // time, say): colour c is the groups colour_order()[k] for k in [colour_start()[c],
-  // colour_start()[c + 1]), group g the elements [g * group_size(), (g + 1) * group_size()).
-  const std::vector<int>& colour_order() const { return colour_order_; }
-  const std::vector<int>& colour_start() const { return colour_start_; }
-  int group_size() const { return group_; }
+  // The colouring's pass, for any way of computing a group's elements (one or several at a
+  // time): group(first, last, fallbacks) on the elements [first, last) of every group, colour
+  // after colour, on every thread; each thread counts into its own fallbacks, and the sum of
+  // all is returned.
+  template <class Group>
+  long long for_coloured_groups(Group&& group);
 
  private:
   void start_system(const State& state) override;
@@ -90,5 +92,23 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   BlockJacobi block_jacobi_;
   Preconditioner* preconditioner_ = &block_jacobi_;
 };
+
+template <class Group>
+long long ThreadsStepper::for_coloured_groups(Group&& group) {
+  long long fallbacks = 0;
+  run_parallel([&] {
+    long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
+    for (int colour = 0; colour < colours(); ++colour) {
+      // The barrier at the end of each loop orders the colours: no two threads ever add
+      // into the same node's blocks at the same time.
+      for (const int k : StaticShare(colour_start_[colour], colour_start_[colour + 1])) {
+        const int first = colour_order_[k] * group_;
+        group(first, std::min(static_cast<int>(model_.tets.size()), first + group_), my_fallbacks);
+      }
+    }
+    add_count(fallbacks, my_fallbacks);
+  });
+  return fallbacks;
+}
 
 }  // namespace fem::ch09

@@ -116,6 +116,7 @@ struct CoarsestSolve {
 template <int B>
 struct Level {
   using Block = Eigen::Matrix<double, B, B>;
+  static constexpr int block_size = B;
 
   BlockCsr<B, B> A;  // pattern; values in A.blocks except on the finest level
   const Block* values = nullptr;
@@ -136,15 +137,11 @@ struct Level {
   int dofs() const { return B * nodes(); }
 };
 
-// What the V-cycle asks of any level (also chapter-specific ones): its row blocks and
-// whether it is the coarsest.
+// The level whose pattern, row blocks and transfers the V-cycle and the smoothers read: a
+// level that stores other numbers on the same hierarchy answers with the level it copies.
 template <int B>
-const RowBlocks& row_blocks(const Level<B>& level) {
-  return level.rows;
-}
-template <int B>
-bool is_coarsest(const Level<B>& level) {
-  return level.coarsest;
+const Level<B>& source_level(const Level<B>& level) {
+  return level;
 }
 
 // The level's fixed row blocks, as chapter 09's RowChunks: equal numbers of stored blocks,

@@ -153,31 +153,38 @@ void gauss_seidel(const Level<B>& level, int first, int last, const Eigen::Vecto
   }
 }
 
+// D_i^-1 r as an expression: `beta * (D_i^-1 r)` then evaluates as Eigen rewrites a scalar
+// times a product, (beta D_i^-1) r (the scalar-times-product evaluator, Eigen/src/Core/
+// ProductEvaluators.h).
+template <int B, class Rhs>
+EIGEN_ALWAYS_INLINE auto times_inverse_diagonal(const Level<B>& level, int i, const Rhs& r) {
+  return level.smoother.inverse_diagonal[i] * r;
+}
+
 // A polynomial smoother's step k: d = alpha d + beta D^-1 (b - A in), out = in + d; from
 // zero (in null) d = beta D^-1 b, out = d. Reads in on every row, writes out and d on its own.
-template <int B>
-void polynomial_step(Level<B>& level, int k, int first, int last, const Eigen::VectorXd& b,
-                     const Eigen::VectorXd* in, Eigen::VectorXd& out) {
-  const SmootherNumbers<B>& numbers = level.smoother;
-  const double alpha = numbers.weights[2 * k], beta = numbers.weights[2 * k + 1];
-  const auto& A = level.A;
-  if (!in) {
-    for (int i = first; i < last; ++i) {
-      auto d = level.vectors.direction.template segment<B>(B * i);
-      d.noalias() = beta * (numbers.inverse_diagonal[i] * b.template segment<B>(B * i));
-      out.template segment<B>(B * i) = d;
-    }
-    return;
-  }
+// For any level whose numbers answer row_product and times_inverse_diagonal (found by
+// argument-dependent lookup) and hold their weights in level.smoother.weights. One loop in
+// this form for every level: GCC fuses a multiply and an add where it sees them
+// (-ffp-contract=fast, its default), so the loop's form is part of the rounding.
+template <class L, class Vector>
+void polynomial_step(L& level, int k, int first, int last, const Vector& b, const Vector* in,
+                     Vector& out) {
+  constexpr int B = L::block_size;
+  const auto alpha = level.smoother.weights[2 * k], beta = level.smoother.weights[2 * k + 1];
+  const auto& A = source_level(level).A;
   for (int i = first; i < last; ++i) {
-    const Eigen::Matrix<double, B, 1> r =
-        b.template segment<B>(B * i) - row_product(level, *in, A.row_start[i], A.row_start[i + 1]);
+    Eigen::Matrix<typename Vector::Scalar, B, 1> r = b.template segment<B>(B * i);
+    if (in) r -= row_product(level, *in, A.row_start[i], A.row_start[i + 1]);
     auto d = level.vectors.direction.template segment<B>(B * i);
-    if (k == 0)
-      d.noalias() = beta * (numbers.inverse_diagonal[i] * r);
+    if (k == 0 || !in)
+      d.noalias() = beta * times_inverse_diagonal(level, i, r);
     else
-      d = alpha * d + beta * (numbers.inverse_diagonal[i] * r);
-    out.template segment<B>(B * i) = in->template segment<B>(B * i) + d;
+      d = alpha * d + beta * times_inverse_diagonal(level, i, r);
+    if (in)
+      out.template segment<B>(B * i) = in->template segment<B>(B * i) + d;
+    else
+      out.template segment<B>(B * i) = d;
   }
 }
 
@@ -203,6 +210,16 @@ void smooth(Level<B>& level, int k, int first, int last, const Eigen::VectorXd& 
     gauss_seidel_from_zero(level, first, last, b, out);
 }
 
+// b - A x on row i.
+template <class L, class Vector, int B = L::block_size>
+EIGEN_ALWAYS_INLINE Eigen::Matrix<typename Vector::Scalar, B, 1> plain_residual(const L& level,
+                                                                                int i,
+                                                                                const Vector& b,
+                                                                                const Vector& x) {
+  const auto& A = source_level(level).A;
+  return b.template segment<B>(B * i) - row_product(level, x, A.row_start[i], A.row_start[i + 1]);
+}
+
 // b - A x on rows [first, last) into the level's residual vector. After exactly one forward
 // Gauss-Seidel sweep from zero, (D + diag(l1) + L_block) x = b row by row, so the residual is
 // l1 x minus the product of the blocks right of the diagonal and outside the block: the
@@ -219,8 +236,26 @@ void residual(Level<B>& level, int first, int last, const Eigen::VectorXd& b,
           row_product(level, x, A.row_start[i], level.rows.inner_begin[i]) -
           row_product(level, x, level.diagonal[i] + 1, A.row_start[i + 1]);
     else
-      r = b.template segment<B>(B * i) - row_product(level, x, A.row_start[i], A.row_start[i + 1]);
+      r = plain_residual(level, i, b, x);
   }
+}
+
+// A level on the same hierarchy with other numbers and a polynomial smoother: the same
+// smoothing steps, the polynomial steps and the plain residual, on its own kernels.
+template <class L>
+int smoothing_steps(const L& level) {
+  return static_cast<int>(level.smoother.weights.size()) / 2;
+}
+template <class L, class Vector>
+void smooth(L& level, int k, int first, int last, const Vector& b, const Vector* in, Vector& out,
+            bool /*forward*/) {
+  polynomial_step(level, k, first, last, b, in, out);
+}
+template <class L, class Vector>
+void residual(L& level, int first, int last, const Vector& b, const Vector& x) {
+  constexpr int B = L::block_size;
+  for (int i = first; i < last; ++i)
+    level.vectors.residual.template segment<B>(B * i) = plain_residual(level, i, b, x);
 }
 
 }  // namespace fem::ch10

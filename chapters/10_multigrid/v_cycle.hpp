@@ -1,6 +1,6 @@
 // Chapter 10: the V-cycle, written once for any level's numbers. A level type brings its own
 // kernels, found by argument-dependent lookup as AMGCL's backends bring theirs:
-//   row_blocks(level), is_coarsest(level), smoothing_steps(level),
+//   source_level(level) (its row blocks, and whether it is the coarsest), smoothing_steps(level),
 //   smooth(level, k, first, last, b, in, out, forward), residual(level, first, last, b, x),
 //   restrict_rows(level, coarse, first, last), prolong_rows(level, coarse, first, last, x),
 //   solve_coarsest(level, b, out),
@@ -26,12 +26,12 @@ namespace fem::ch10 {
 template <class Level, class Coarse, class Vector>
 void v_cycle(Level& level, std::vector<Coarse>& coarse, std::size_t next, const Vector& b,
              Vector& out, bool collective) {
-  const std::vector<int>& part = row_blocks(level).part;
-  if (collective && row_blocks(level).serial) {
+  const std::vector<int>& part = source_level(level).rows.part;
+  if (collective && source_level(level).rows.serial) {
     ch09::on_one_thread(true, [&] { v_cycle(level, coarse, next, b, out, false); });
     return;
   }
-  if (is_coarsest(level)) {
+  if (source_level(level).coarsest) {
     ch09::on_one_thread(collective, [&] { solve_coarsest(level, b, out); });
     return;
   }
@@ -51,7 +51,7 @@ void v_cycle(Level& level, std::vector<Coarse>& coarse, std::size_t next, const 
   // The coarse correction: the residual restricted, the next level's cycle, and its
   // correction prolonged, y = x + P x_c.
   Coarse& below = coarse[next];
-  ch09::for_parts(row_blocks(below).part, collective,
+  ch09::for_parts(source_level(below).rows.part, collective,
                   [&](int first, int last) { restrict_rows(level, below, first, last); });
   v_cycle(below, coarse, next + 1, below.vectors.b, below.vectors.x, collective);
   ch09::for_parts(part, collective,

@@ -78,9 +78,7 @@ std::string one_mesh_table(const LessonRun& run) {
   // Interleaved, one step of each order in turn, as fem_bench runs chapters: a drift of the
   // machine's speed hits every order alike. The first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
-    if (k % 5 == 0)
-      progress("node-order: step " + std::to_string(k + 1) + " of " +
-               std::to_string(run.steps + 2));
+    step_progress("node-order", k, run.steps + 2, 5);
     for (Run& r : runs) {
       r.stepper->step(r.state);
       if (k < 2) continue;
@@ -105,13 +103,7 @@ std::string one_mesh_table(const LessonRun& run) {
 }
 
 // The scene's mesh, then each of --meshes (the same scene and material on it): one table each.
-std::string node_order_table(const LessonRun& run) {
-  const std::vector<Scene> scenes = more_meshes(run);
-  std::string tables = one_mesh_table(run);
-  for (const Scene& scene : scenes)
-    tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter});
-  return tables;
-}
+std::string node_order_table(const LessonRun& run) { return on_every_mesh(run, one_mesh_table); }
 
 void add_node_order_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");

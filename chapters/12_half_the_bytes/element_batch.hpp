@@ -65,8 +65,7 @@ class BatchedElements {
   long long last_step_fallbacks_ = 0;
 };
 
-// b += lane l's terms, A += its blocks (ten computed, sixteen written), at the element's blocks
-// of the pattern: ch08::scatter for one lane.
+// b += lane l's terms, A += its blocks: ch08::scatter on lane l's ElementTerms.
 void scatter(const BatchTerms& terms, int lane, const Eigen::Vector4i& t,
              const std::array<int, 16>& blocks, ch07::BlockSparseMatrix& A, Eigen::VectorXd& b);
 

@@ -3,17 +3,13 @@
 
 #include <algorithm>
 #include <array>
-#include <iomanip>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
-#include "chapters/08_element_kernels/element_kernels.hpp"
-#include "chapters/10_multigrid/report.hpp"
 #include "chapters/11_node_order/node_order.hpp"
-#include "chapters/11_node_order/stepper.hpp"
-#include "chapters/12_half_the_bytes/element_batch.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "common/cli.hpp"
 #include "common/mesh.hpp"
@@ -22,18 +18,6 @@
 namespace fem::ch12 {
 
 namespace {
-
-// Chapter 10's hierarchy in double: every level's blocks and inverse diagonals, P and P^T
-// (the coarsest level is a dense Cholesky factor, the same in both chapters: not counted).
-double double_megabytes(const ch10::Multigrid& mg) {
-  long long bytes = 0;
-  for (int l = 0; l + 1 < mg.levels(); ++l) {
-    const long long b = l == 0 ? 3 : ch10::kModes;
-    bytes += 8 * b * b * (ch10::level_blocks(mg, l) + ch10::level_dofs(mg, l) / b);
-    bytes += 2 * 8 * b * ch10::kModes * ch10::prolongator_blocks(mg, l);
-  }
-  return 1e-6 * static_cast<double>(bytes);
-}
 
 // One variant of the preconditioner: a stepper at the default tolerance (times, iterations)
 // and one at each tight tolerance (iterations), stepped side by side.
@@ -82,9 +66,7 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
   }
   // Interleaved, one step of each in turn; the first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
-    if (k % 5 == 0)
-      progress("half-the-bytes: step " + std::to_string(k + 1) + " of " +
-               std::to_string(run.steps + 2));
+    step_progress("half-the-bytes", k, run.steps + 2, 5);
     for (Run& r : runs) {
       r.stepper->step(r.state);
       r.converged = r.converged && r.stepper->profile().converged;
@@ -98,7 +80,10 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
       r.iterations.push_back(r.stepper->profile().cg_iterations);
     }
   }
-  const double mb = double_megabytes(runs[0].stepper->multigrid());
+  // Chapter 10's numbers in double take twice the float ones' bytes (the tests check it).
+  auto& single = static_cast<HalfBytesStepper&>(*runs[1].stepper).v_cycle();
+  const long long bytes = 2 * static_cast<ReducedVCycle<float>&>(single).number_bytes();
+  const double mb = 1e-6 * static_cast<double>(bytes);
   std::ostringstream out;
   out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes), V-cycle"
       << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at 1e-4";
@@ -125,23 +110,13 @@ std::string half_the_bytes_table(const LessonRun& run) {
   std::vector<double> tight;
   std::stringstream tolerances(run.args.get("tight"));
   for (std::string t; std::getline(tolerances, t, ',');) {
-    std::size_t used = 0;
-    double value = 0.0;
-    try {
-      value = std::stod(t, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != t.size() || !(value > 0.0 && value < 1.0))
+    const std::optional<double> value = parse_double(t);
+    if (!value || !(*value > 0.0 && *value < 1.0))
       throw std::invalid_argument("--tight: tolerances in (0, 1), comma-separated, not '" + t +
                                   "'");
-    tight.push_back(value);
+    tight.push_back(*value);
   }
-  const std::vector<Scene> scenes = more_meshes(run);
-  std::string tables = one_mesh_table(run, tight);
-  for (const Scene& scene : scenes)
-    tables += "\n" + one_mesh_table({run.args, scene, run.steps, run.chapter}, tight);
-  return tables;
+  return on_every_mesh(run, [&](const LessonRun& r) { return one_mesh_table(r, tight); });
 }
 
 // The four element passes of the table, each with its own elements' state, so that each
@@ -214,9 +189,7 @@ std::string one_mesh_elements(const LessonRun& run) {
   State state = rest_state(scene);
   std::vector<double> ns[4];
   for (int k = 0; k < run.steps + 2; ++k) {
-    if (k % 10 == 0)
-      progress("batched-elements: step " + std::to_string(k + 1) + " of " +
-               std::to_string(run.steps + 2));
+    step_progress("batched-elements", k, run.steps + 2, 10);
     stepper.step(state);
     const std::array<double, 4> ms = passes.time(state);
     if (k < 2) continue;
@@ -233,15 +206,12 @@ std::string one_mesh_elements(const LessonRun& run) {
 }
 
 std::string batched_elements_table(const LessonRun& run) {
-  const std::vector<Scene> scenes = more_meshes(run);
   const std::string lanes = std::to_string(kLanes);
   std::string table =
       "| mesh | elements | terms: one at a time (chapter 08), ns per element | terms: " + lanes +
       " at a time (chapter 12) | speedup | with the scatter: chapter 08 | with the scatter: "
       "chapter 12 | speedup |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
-  table += one_mesh_elements(run);
-  for (const Scene& scene : scenes)
-    table += one_mesh_elements({run.args, scene, run.steps, run.chapter});
+  table += on_every_mesh(run, one_mesh_elements, "");
   return table +
          "\nOne thread; the terms of every element (rotation, forces, the ten blocks), alone "
          "and with their scatter into A and b (the element pass, serial); medians over " +

@@ -1,7 +1,7 @@
-// Chapter 12: the kernels of chapter 10's V-cycle (v_cycle.hpp) on float levels, and the
-// conversion of chapter 10's numbers into them (see reduced_v_cycle.hpp). Only the polynomial
-// smoothers are here, the ones whose every sweep reads the whole level (Gauss-Seidel would be
-// the same change once more).
+// Chapter 12: the products of chapter 10's V-cycle (v_cycle.hpp) on float levels, and the
+// conversion of chapter 10's numbers into them (see reduced_v_cycle.hpp). Chapter 10's
+// polynomial smoothers and residual run on these products; Gauss-Seidel would be the same
+// change once more.
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
 
 #include <stdexcept>
@@ -65,67 +65,32 @@ EIGEN_ALWAYS_INLINE void add_product(Sums<Real, R, C>& sums, const Eigen::Matrix
 // sum of A_k x_(column k) over the blocks [begin, end) of a row: 2 B independent sums (two
 // blocks at a time, as chapter 10's row_product, and a sum per block column).
 template <class Real, int B>
-EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> row_product(const ReducedLevel<Real, B>& level,
-                                                          const Real* x, int begin, int end) {
+EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> row_product(
+    const ReducedLevel<Real, B>& level, const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x, int begin,
+    int end) {
   auto even = Sums<Real, B, B>::Zero(), odd = Sums<Real, B, B>::Zero();
   const int* column = level.source->A.column.data();
   const Eigen::Matrix<float, B, B>* blocks = level.blocks.data();
   int k = begin;
   for (; k + 1 < end; k += 2) {
-    add_product(even, blocks[k], x + B * column[k]);
-    add_product(odd, blocks[k + 1], x + B * column[k + 1]);
+    add_product(even, blocks[k], x.data() + B * column[k]);
+    add_product(odd, blocks[k + 1], x.data() + B * column[k + 1]);
   }
-  if (k < end) add_product(even, blocks[k], x + B * column[k]);
+  if (k < end) add_product(even, blocks[k], x.data() + B * column[k]);
   return even.total() + odd.total();
 }
 
-template <class Real, int B>
+// D_i^-1 r, for chapter 10's polynomial_step (its smooth and residual serve this level).
+template <class Real, int B, class Rhs>
 EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> times_inverse_diagonal(
-    const ReducedLevel<Real, B>& level, int i, const Eigen::Matrix<Real, B, 1>& r) {
+    const ReducedLevel<Real, B>& level, int i, const Rhs& r) {
   auto out = Sums<Real, B, B>::Zero();
-  add_product(out, level.inverse_diagonal[i], r.data());
+  add_product(out, level.smoother.inverse_diagonal[i], r.data());
   return out.total();
 }
-
-template <class Real, int B>
-int smoothing_steps(const ReducedLevel<Real, B>& level) {
-  return static_cast<int>(level.weights.size()) / 2;
-}
-
-// Chapter 10's polynomial_step: d = alpha d + beta D^-1 (b - A in), out = in + d (its own
-// adjoint: the same step before and after the coarse correction).
-template <class Real, int B>
-void smooth(ReducedLevel<Real, B>& level, int k, int first, int last,
-            const Eigen::Matrix<Real, Eigen::Dynamic, 1>& b,
-            const Eigen::Matrix<Real, Eigen::Dynamic, 1>* in,
-            Eigen::Matrix<Real, Eigen::Dynamic, 1>& out, bool /*forward*/) {
-  using Vector = Eigen::Matrix<Real, B, 1>;
-  const Real alpha = level.weights[2 * k], beta = level.weights[2 * k + 1];
-  const std::vector<int>& row_start = level.source->A.row_start;
-  for (int i = first; i < last; ++i) {
-    Vector r = b.template segment<B>(B * i);
-    if (in) r -= row_product(level, in->data(), row_start[i], row_start[i + 1]);
-    auto d = level.vectors.direction.template segment<B>(B * i);
-    if (k == 0 || !in)
-      d = beta * times_inverse_diagonal(level, i, r);
-    else
-      d = alpha * d + beta * times_inverse_diagonal(level, i, r);
-    if (in)
-      out.template segment<B>(B * i) = in->template segment<B>(B * i) + d;
-    else
-      out.template segment<B>(B * i) = d;
-  }
-}
-
-template <class Real, int B>
-void residual(ReducedLevel<Real, B>& level, int first, int last,
-              const Eigen::Matrix<Real, Eigen::Dynamic, 1>& b,
-              const Eigen::Matrix<Real, Eigen::Dynamic, 1>& x) {
-  const std::vector<int>& row_start = level.source->A.row_start;
-  for (int i = first; i < last; ++i)
-    level.vectors.residual.template segment<B>(B * i) =
-        b.template segment<B>(B * i) - row_product(level, x.data(), row_start[i], row_start[i + 1]);
-}
+using ch10::residual;
+using ch10::smooth;
+using ch10::smoothing_steps;
 
 // b_c = R r on coarse rows [first, last), fine rows in increasing order.
 template <class Real, int B>
@@ -174,7 +139,7 @@ void size_level(ReducedLevel<Real, B>& level, const ch10::Level<B>& source) {
   }
   // One padding block after each array (add_product reads a few floats past a block's end).
   level.blocks.resize(source.A.column.size() + 1, Eigen::Matrix<float, B, B>::Zero());
-  level.inverse_diagonal.resize(source.nodes() + 1, Eigen::Matrix<float, B, B>::Zero());
+  level.smoother.inverse_diagonal.resize(source.nodes() + 1, Eigen::Matrix<float, B, B>::Zero());
   level.P.resize(source.transfer.P.blocks.size() + 1, Eigen::Matrix<float, B, kModes>::Zero());
   level.R.resize(source.transfer.R.blocks.size() + 1, Eigen::Matrix<float, kModes, B>::Zero());
 }
@@ -207,7 +172,8 @@ void ReducedVCycle<Real>::convert(ReducedLevel<Real, B>& level, bool refreshed, 
     for (int k = source.A.row_start[first]; k < source.A.row_start[last]; ++k)
       level.blocks[k] = source.values[k].template cast<float>();
     for (int i = first; i < last; ++i)
-      level.inverse_diagonal[i] = source.smoother.inverse_diagonal[i].template cast<float>();
+      level.smoother.inverse_diagonal[i] =
+          source.smoother.inverse_diagonal[i].template cast<float>();
     if (!refreshed) return;
     for (int m = transfer.P.row_start[first]; m < transfer.P.row_start[last]; ++m)
       level.P[m] = transfer.P.blocks[m].template cast<float>();
@@ -217,7 +183,7 @@ void ReducedVCycle<Real>::convert(ReducedLevel<Real, B>& level, bool refreshed, 
     // R's rows belong to the coarse level's partition: few blocks, one thread.
     for (std::size_t e = 0; e < transfer.R.blocks.size(); ++e)
       level.R[e] = transfer.R.blocks[e].template cast<float>();
-    level.weights.assign(source.smoother.weights.begin(), source.smoother.weights.end());
+    level.smoother.weights.assign(source.smoother.weights.begin(), source.smoother.weights.end());
   });
 }
 
@@ -265,7 +231,7 @@ long long ReducedVCycle<Real>::number_bytes() const {
     const auto& source = *level.source;
     if (source.coarsest) return 0LL;
     return static_cast<long long>(sizeof(level.blocks[0]) * source.A.column.size() +
-                                  sizeof(level.inverse_diagonal[0]) * source.nodes() +
+                                  sizeof(level.smoother.inverse_diagonal[0]) * source.nodes() +
                                   sizeof(level.P[0]) * source.transfer.P.blocks.size() +
                                   sizeof(level.R[0]) * source.transfer.R.blocks.size());
   };

@@ -30,26 +30,23 @@ using ch10::kModes;
 // row blocks, the refresh rule and the coarsest Cholesky factor stay the source level's.
 template <class Real, int B>
 struct ReducedLevel {
+  static constexpr int block_size = B;
   const ch10::Level<B>* source = nullptr;
-  std::vector<Eigen::Matrix<float, B, B>> blocks;            // the level's matrix
-  std::vector<Eigen::Matrix<float, B, B>> inverse_diagonal;  // the smoother's D^-1
-  std::vector<Eigen::Matrix<float, B, kModes>> P;            // the prolongator's blocks
-  std::vector<Eigen::Matrix<float, kModes, B>> R;            // the restriction's, in R's order
-  std::vector<Real> weights;                                 // the smoother's weights
+  std::vector<Eigen::Matrix<float, B, B>> blocks;  // the level's matrix
+  std::vector<Eigen::Matrix<float, B, kModes>> P;  // the prolongator's blocks
+  std::vector<Eigen::Matrix<float, kModes, B>> R;  // the restriction's, in R's order
+  struct {
+    std::vector<Eigen::Matrix<float, B, B>> inverse_diagonal;  // D^-1
+    std::vector<Real> weights;
+  } smoother;
   ch10::WorkVectors<Real> vectors;
   Eigen::VectorXd dense;  // coarsest level: the right-hand side of the double Cholesky
-
-  int nodes() const { return source->nodes(); }
 };
 
-// What chapter 10's V-cycle asks of a level, answered by the source level.
+// The pattern, row blocks and transfers of chapter 10's V-cycle and smoothers: the source's.
 template <class Real, int B>
-const ch10::RowBlocks& row_blocks(const ReducedLevel<Real, B>& level) {
-  return level.source->rows;
-}
-template <class Real, int B>
-bool is_coarsest(const ReducedLevel<Real, B>& level) {
-  return level.source->coarsest;
+const ch10::Level<B>& source_level(const ReducedLevel<Real, B>& level) {
+  return *level.source;
 }
 
 enum class Arithmetic { single, double_on_float };

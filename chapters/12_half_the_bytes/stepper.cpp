@@ -4,8 +4,6 @@
 
 #include <algorithm>
 
-#include "chapters/09_threads/parallel.hpp"
-
 namespace fem::ch12 {
 
 namespace {
@@ -34,26 +32,15 @@ void HalfBytesStepper::element_pass(const State& state) {
   // Chapter 09's colour loop; inside a group, kLanes consecutive elements at a time, each
   // batch's terms scattered in element order, so the sums (and the state) are the same for
   // any thread count.
-  const std::vector<int>& order = colour_order();
-  const std::vector<int>& start = colour_start();
-  const int group = group_size(), elements = static_cast<int>(model_.tets.size());
-  long long fallbacks = 0;
-  ch09::run_parallel([&] {
+  batched_.end_pass(for_coloured_groups([&](int first, int last, long long& fallbacks) {
     BatchTerms terms;  // on this thread's stack: no allocation, no sharing
-    long long mine = 0;
-    for (std::size_t colour = 0; colour + 1 < start.size(); ++colour)
-      for (const int k : ch09::StaticShare(start[colour], start[colour + 1])) {
-        const int first = order[k] * group, last = std::min(elements, first + group);
-        for (int e = first; e < last; e += kLanes) {
-          const int count = std::min(kLanes, last - e);
-          batched_.terms(e, count, model_.tets, state, mine, terms);
-          for (int l = 0; l < count; ++l)
-            scatter(terms, l, model_.tets[e + l], index_.element[e + l], A_, b_);
-        }
-      }
-    ch09::add_count(fallbacks, mine);
-  });
-  batched_.end_pass(fallbacks);
+    for (int e = first; e < last; e += kLanes) {
+      const int count = std::min(kLanes, last - e);
+      batched_.terms(e, count, model_.tets, state, fallbacks, terms);
+      for (int l = 0; l < count; ++l)
+        scatter(terms, l, model_.tets[e + l], index_.element[e + l], A_, b_);
+    }
+  }));
 }
 
 }  // namespace fem::ch12
