@@ -65,7 +65,8 @@ class BatchedElements {
   long long last_step_fallbacks_ = 0;
 };
 
-// b += lane l's terms, A += its blocks: ch08::scatter on lane l's ElementTerms.
+// b += lane l's terms, A += its blocks (ten computed, sixteen written), at the element's blocks
+// of the pattern: ch08::scatter for one lane.
 void scatter(const BatchTerms& terms, int lane, const Eigen::Vector4i& t,
              const std::array<int, 16>& blocks, ch07::BlockSparseMatrix& A, Eigen::VectorXd& b);
 
