@@ -38,7 +38,7 @@ def roofs(ax, roof, x):
 def points(ax, runs, threads):
     chapters = sorted({r["chapter"] for r in runs})
     colours = {c: matplotlib.colormaps["tab20"](i % 20) for i, c in enumerate(chapters)}
-    meshes = sorted({r["mesh"] for r in runs})
+    meshes = list(dict.fromkeys(r["mesh"] for r in runs))  # the run's mesh first, then the further ones
     for r in runs:
         if r["threads"] != threads:
             continue
