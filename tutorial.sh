@@ -250,8 +250,9 @@ run_tests() {
 with_heartbeat() {
   local line start=$SECONDS done=0 status
   while :; do
-    IFS= read -r -t 30 line
-    status=$?
+    # (the status taken inside a condition: under set -e a timed-out read would end the script)
+    status=0
+    IFS= read -r -t 30 line || status=$?
     if [ "$status" -eq 0 ]; then
       printf '%s\n' "$line"
       [[ "$line" =~ Test\ +#[0-9]+: ]] && done=$((done + 1))
