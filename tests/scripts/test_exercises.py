@@ -210,7 +210,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--keep", type=pathlib.Path, help="work in this folder and keep it")
     parser.add_argument("--only", help="comma-separated exercise ids (e.g. 07/3,10/4): only these")
+    parser.add_argument("--chapters", help="FIRST-LAST (e.g. 01-06): only the exercises of these "
+                        "chapters' READMEs (ctest runs two ranges side by side)")
     args = parser.parse_args()
+    if args.chapters:
+        first, _, last = args.chapters.partition("-")
+        EXERCISES[:] = [ex for ex in EXERCISES if first <= ex["id"][:2] <= (last or first)]
+        if not EXERCISES:
+            parser.error(f"no exercise in chapters {args.chapters}")
     if args.only:
         wanted = args.only.split(",")
         unknown = [w for w in wanted if w not in {ex["id"] for ex in EXERCISES}]
