@@ -269,11 +269,12 @@ with_heartbeat() {
 # A run is a folder: fem_bench writes DIR/bench.json and the plots are made from that file,
 # so plots and numbers always belong together.
 bench() {
-  local out="" json="" args=("$@") i
+  local out="" json="" no_json=0 args=("$@") i
   for ((i = 0; i < ${#args[@]}; i++)); do
     case "${args[i]}" in
       --out) out="${args[i + 1]:-}"; [ -n "$out" ] || { echo "tutorial.sh bench: --out needs a folder" >&2; exit 2; } ;;
       --json) json="${args[i + 1]:-}" ;;
+      --no-json) no_json=1 ;;
     esac
   done
   # The run's folder before the build and the run (fem_bench checks its other arguments before
@@ -287,7 +288,9 @@ bench() {
   quiet_build
   log "benchmarking: fem_bench $* (the run's folder: ${out:-a new one under results/})"
   "$BUILD_DIR/fem_bench" "$@"
-  if [ -n "$json" ]; then
+  if [ "$no_json" -eq 1 ]; then
+    return 0  # no JSON, no plots (results/latest still names the last run that wrote one)
+  elif [ -n "$json" ]; then
     plots "$json" "${out:-$(dirname "$json")}"
   else
     out="${out:-results/$(readlink results/latest)}"
