@@ -18,6 +18,9 @@ APT_PACKAGES=(
   libeigen3-dev catch2
   # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
   libsuitesparse-dev
+  # JSON written and read in C++ (header-only); likwid-bench, the independent check of the
+  # roofline's bandwidth and peak (fem_lessons roofline)
+  nlohmann-json3-dev likwid
   # gmsh's runtime libraries (the PyPI wheel links against them)
   libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
   # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
