@@ -12,7 +12,7 @@
 namespace fem::ch09 {
 
 RowChunks::RowChunks(const BlockSparseMatrix& pattern)
-    // Fewer chunks on a small mesh (at least kMinRows rows each), where a chunk's fixed cost
+    // Fewer chunks on a small mesh (kMinRows rows each on average), where a chunk's fixed cost
     // would show; still a function of the mesh alone.
     : start(equal_block_partition(pattern.row_start,
                                   std::clamp(pattern.block_rows() / kMinRows, 1, kMaxCount))) {}

@@ -120,12 +120,14 @@ EXERCISES = [
     # Written in chapter 10's README, done in a variant of chapter 09 and measured beside both.
     {"id": "10/5", "chapter": "09", "readme": "10", "name": "ex_guess",
      "change": [("stepper.hpp", "  long long steps_taken_ = 0;\n",
-                 "  long long steps_taken_ = 0;\n  Eigen::VectorXd previous_;  // y_(n-1)\n"),
+                 "  long long steps_taken_ = 0;\n"
+                 "  Eigen::VectorXd previous_, before_previous_;  // y_(n-1), y_(n-2)\n"),
                 ("  // Warm start: y_ still holds the previous step's answer; the solver filters it.\n",
-                 "  if (previous_.size() != y_.size()) previous_ = y_;\n"
+                 "  if (previous_.size() != y_.size()) previous_ = before_previous_ = y_;\n"
                  "  for (Eigen::Index k = 0; k < y_.size(); ++k) {\n"
                  "    const double last = y_[k];\n"
-                 "    y_[k] = 2.0 * last - previous_[k];\n"
+                 "    y_[k] = 3.0 * last - 3.0 * previous_[k] + before_previous_[k];\n"
+                 "    before_previous_[k] = previous_[k];\n"
                  "    previous_[k] = last;\n"
                  "  }\n")],
      "bench": "build/release/fem_bench --chapters 09,09_NAME,10 --no-solvers --no-json",
