@@ -71,7 +71,12 @@ commands:
   threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
              thread on the poster-sized mesh: results/threads.json and results/threads.png
              (step and solve time against threads, with the ideal line)
-  docs       commit the run in results/latest (and results/*.json) as docs/data/*.json and regenerate the generated parts
+  book       record the book in one sitting on this machine (about 45 minutes on 2 cores; it
+             refuses a busy machine unless --busy): the bench, the thread sweep, the scaling
+             series, the regime sweep, the viewer's frame rate, every lesson and the roofline,
+             then the docs regenerated from them and docs/data/book.json, which ties the data
+             to the code it measured (ctest -L docs checks it)
+  docs       commit the run in results/latest (or the folder given) (and results/*.json) as docs/data/*.json and regenerate the generated parts
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the figures of chapters 10-12 (scripts/figures.py), the
@@ -413,9 +418,8 @@ roofline() {
 
 docs() {
   quiet_build
-  local run=results/latest
-  [ -f "$run/bench.json" ] || run=results  # a run made before runs had folders of their own
-  [ -f "$run/bench.json" ] || { echo "no results/latest/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
+  local run=${1:-results/latest}
+  [ -f "$run/bench.json" ] || { echo "no $run/bench.json: run ./tutorial.sh bench first" >&2; exit 1; }
   lessons
   log "results: the run's JSON committed under docs/data/, tables and plots from it"
   mkdir -p docs/data
@@ -467,6 +471,63 @@ viewer_bench() {
   "$VENV/bin/python" scripts/viewer_fps.py --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"
 }
 
+# The book: every measurement the docs show, recorded on this machine in one sitting, then the
+# docs regenerated from it and docs/data/book.json written (scripts/book.py: the sources each
+# chapter's data come from; ctest -L docs fails once a chapter's code differs from them).
+book_quiet_check() {
+  local load cores
+  read -r load _ </proc/loadavg
+  cores=$(nproc)
+  # Busy: a 1-minute load above a quarter of the cores (one helper compiling is far above it).
+  if awk -v l="$load" -v c="$cores" 'BEGIN { exit !(l > c / 4) }'; then
+    echo "tutorial.sh book: the machine is not quiet (1-minute load $load on $cores cores); what runs:" >&2
+    ps -eo pcpu=,pid=,args= --sort=-pcpu | awk '$1 > 2' | head -n 8 >&2
+    echo "stop it and try again, or pass --busy to record anyway (the data will say so)" >&2
+    exit 1
+  fi
+}
+
+book_stage() {  # book_stage NAME COMMAND...: one timed stage, with the time left before it
+  local name=$1 start=$SECONDS left=0 stage
+  shift
+  BOOK_STAGE=$((BOOK_STAGE + 1))
+  for stage in "${BOOK_ORDER[@]:$((BOOK_STAGE - 1))}"; do left=$((left + ${BOOK_ESTIMATE[$stage]:-300})); done
+  log "book [$BOOK_STAGE/${#BOOK_ORDER[@]}] $name: $((($SECONDS - BOOK_START) / 60)) min so far, about $((left / 60)) min left"
+  "$@"
+  BOOK_TIMES+=("$name=$((SECONDS - start))")
+}
+
+book() {
+  [ "${1:-}" = "--busy" ] || book_quiet_check
+  if [ -n "$(git status --porcelain -- chapters common apps)" ]; then
+    echo "tutorial.sh book: chapters/, common/ or apps/ hold uncommitted changes; the book records" >&2
+    echo "committed code only (commit them first):" >&2
+    git status --short -- chapters common apps >&2
+    exit 1
+  fi
+  quiet_build
+  BOOK_ORDER=(meshes bench threads scaling regimes viewer docs)
+  declare -gA BOOK_ESTIMATE=([meshes]=60 [bench]=240 [threads]=120 [scaling]=600 [regimes]=420
+                             [viewer]=120 [docs]=900)
+  local name seconds
+  while read -r name seconds; do BOOK_ESTIMATE[$name]=$seconds; done \
+    < <("$VENV/bin/python" scripts/book.py estimate)
+  BOOK_STAGE=0 BOOK_START=$SECONDS BOOK_TIMES=()
+  local started
+  started=$(date +%s)
+  book_stage meshes meshes --large
+  rm -rf results/book
+  book_stage bench bench --out results/book --replace
+  book_stage threads threads
+  book_stage scaling scaling
+  book_stage regimes regimes
+  book_stage viewer viewer_bench
+  book_stage docs docs results/book
+  local IFS=,
+  "$VENV/bin/python" scripts/book.py manifest --started "$started" --stages "${BOOK_TIMES[*]}"
+  log "book: recorded in $(((SECONDS - BOOK_START) / 60)) min; commit docs/ (git status docs)"
+}
+
 meshes() {
   setup_python
   "$VENV/bin/python" meshes/generate.py "$@"
@@ -488,7 +549,8 @@ main() {
     scaling) scaling "$@" ;;
     regimes) regimes "$@" ;;
     threads) threads "$@" ;;
-    docs) docs ;;
+    docs) docs "$@" ;;
+    book) book "$@" ;;
     lessons) lessons ;;
     roofline) roofline "$@" ;;
     sim) sim "$@" ;;
