@@ -7,6 +7,7 @@
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
 #include "common/deformation.hpp"
+#include "common/run_lock.hpp"
 #include "common/vtk.hpp"
 
 namespace {
@@ -28,7 +29,7 @@ void add_options(ArgParser& args) {
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
-              "scene's name there is replaced)",
+              "scene's name there is replaced; a folder another run is writing is refused)",
               "out/sim");
 }
 
@@ -59,7 +60,7 @@ Run run_from_args(const ArgParser& args) {
 void print_progress(int k, const Run& run, const Scene& scene, const StepProfile& p) {
   std::cout << "  step " << k << "/" << run.steps << "  t = " << k * scene.dt << " s  step "
             << p.step.seconds * 1e3 << " ms  CG " << p.cg_iterations << " it  residual "
-            << p.relative_residual << "\n";
+            << p.relative_residual << std::endl;
 }
 
 // The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
@@ -71,7 +72,14 @@ void simulate(const Run& run, const Scene& scene, Stepper& stepper,
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
   for (int k = 1; k <= run.steps; ++k) {
+    const auto start = std::chrono::steady_clock::now();
     stepper.step(state);
+    // The first step allocates the stepper's buffers: the estimate is taken from the second.
+    if (k == 2)
+      announce_long_run(
+          "fem_sim",
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+          run.steps);
     if (const char* why = divergence(state, stepper.profile()))
       throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" + why +
                                "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
@@ -83,11 +91,29 @@ void simulate(const Run& run, const Scene& scene, Stepper& stepper,
   deformation.summary(run.steps);
 }
 
+// The output folder is this run's from here to the end (common/run_lock.hpp): a second
+// fem_sim into it is refused before any work, rather than each removing the other's frames.
+std::optional<RunLock> lock_output(const ArgParser& args, const Run& run) {
+  std::optional<RunLock> lock;
+  if (run.every == 0) return lock;
+  try {
+    lock.emplace(args.get("out"), "fem_sim");
+  } catch (const FolderInUse& e) {
+    throw UsageError(std::string("--out: ") + e.what());
+  }
+  if (lock->stale_pid() > 0)
+    std::cout << "note: " << args.get("out") << " held the lock of a run that is gone (pid "
+              << lock->stale_pid() << "); taken over\n";
+  return lock;
+}
+
 void run_scene(const ArgParser& args, const Run& run) {
+  const std::optional<RunLock> lock = lock_output(args, run);
   const Scene scene = scene_from_args(args);
   std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
-            << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s\n";
+            << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s"
+            << std::endl;
   auto stepper = run.chapter->make(scene, run.solver);
   std::cout << "threads: " << (stepper->uses_threads() ? run.threads : 1)
             << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";

@@ -236,6 +236,21 @@ void write_between_markers(const std::string& path, const std::string& name,
   std::ofstream(path) << doc;
 }
 
+void announce_long_run(const std::string& program, double seconds_per_step, long long steps) {
+  const double seconds = seconds_per_step * static_cast<double>(steps);
+  if (!(seconds > 60.0)) return;
+  std::ostringstream about;
+  about.precision(seconds < 600.0 ? 1 : 0);
+  about << std::fixed;
+  if (seconds < 3600.0)
+    about << seconds / 60.0 << " min";
+  else
+    about << seconds / 3600.0 << " h";
+  std::cout << program << ": this run will take about " << about.str() << " (" << steps
+            << " steps at " << format_number(seconds_per_step) << " s each, from the first)"
+            << std::endl;
+}
+
 int run_program(const std::string& program, const std::function<int()>& body) {
   try {
     return body();

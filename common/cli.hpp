@@ -67,6 +67,12 @@ void add_thread_option(ArgParser& args);
 // warns on stderr above the hardware threads.
 int threads_from_args(const ArgParser& args);
 
+// A run that will take longer than a minute says so before it goes on, from its first timed
+// step: "<program>: this run will take about 7 min (N steps at 0.42 s each)". Prints nothing
+// for a shorter one. Flushed, as every progress line is, so that it reaches a file as it
+// reaches a terminal.
+void announce_long_run(const std::string& program, double seconds_per_step, long long steps);
+
 // main()'s error handling, written once: returns body()'s exit status; a UsageError prints
 // "<program>: <why> (see <program> --help)" and returns 2, any other exception
 // "<program>: error: <why>" and returns 1.

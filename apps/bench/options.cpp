@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/bench/run_folder.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
 
@@ -137,9 +138,7 @@ BenchOptions bench_options(const ArgParser& args) {
   if (!o.json.empty() && !o.json_named && args.get("out").empty())
     o.latest = std::filesystem::path(o.json).parent_path().filename().string();
   if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))
-    throw UsageError("'" + o.json +
-                     "' holds an earlier run: give another --out (or --json), or --replace to "
-                     "replace it and its plots");
+    throw UsageError(holds_a_run(o.json));
   o.solve_tables = !args.has_flag("no-solvers");
   return o;
 }

@@ -1,0 +1,145 @@
+#!/usr/bin/env python3
+"""A run's folder belongs to one run, and its results are written whole or not at all
+(common/run_lock.hpp, common/atomic_file.hpp), through the programs as a user runs them:
+fem_bench and fem_sim into a folder another run is writing are refused before any work,
+naming it; --replace replaces a finished run only and says so only then; a write that fails
+(FEM_FAIL_WRITES, a full disk injected) exits non-zero with the path and the cause and
+leaves the folder byte-identical; a run of more than a minute says how long before it goes on,
+and its lines reach a file. Prints 'N passed, M failed' last.
+
+    test_run_folders.py --bench build/release/fem_bench --sim build/release/fem_sim"""
+import argparse
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+MESH = ROOT / "meshes" / "test_beam.msh"
+results = {"passed": 0, "failed": 0}
+
+
+def check(name, condition, detail=""):
+    results["passed" if condition else "failed"] += 1
+    print(f"{'ok  ' if condition else 'FAIL'} {name}{'' if condition else ': ' + str(detail)[:3000]}")
+
+
+def run(*args, env=None):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True,
+                          env={**os.environ, **(env or {})}, timeout=600)
+
+
+def snapshot(folder):
+    return {p.name: p.read_bytes() for p in sorted(pathlib.Path(folder).iterdir())}
+
+
+def wait_for(path, text="", seconds=120):
+    """Waits until the file exists (and holds text); False on timeout."""
+    end = time.time() + seconds
+    while time.time() < end:
+        if path.exists() and text in path.read_text(errors="replace"):
+            return True
+        time.sleep(0.2)
+    return False
+
+
+def holder(args, log):
+    """A long run in the background, its output to a file: the run another one meets."""
+    return subprocess.Popen([str(a) for a in args], stdout=log, stderr=subprocess.STDOUT)
+
+
+def second_run_refused(name, first_args, second_args, folder, tmp):
+    with open(tmp / f"{name}.log", "w") as log:
+        first = holder(first_args, log)
+        try:
+            locked = wait_for(folder / ".fem_run.lock", "pid")
+            p = run(*second_args)
+            check(f"{name}: a second run into the folder is refused (exit 2)", locked and p.returncode == 2,
+                  p.stdout + p.stderr)
+            check(f"{name}: the refusal names the first run (its pid)",
+                  f"pid {first.pid}" in p.stderr and "in use by another run" in p.stderr, p.stderr)
+        finally:
+            first.kill()
+            first.wait()
+
+
+def bench_cases(bench, tmp):
+    base = [bench, "--mesh", MESH, "--chapters", "01", "--no-solvers", "--warmup", "1"]
+    folder = tmp / "bench_run"
+    second_run_refused("fem_bench", base + ["--steps", "1000000", "--out", folder],
+                       base + ["--steps", "2", "--out", folder, "--replace"], folder, tmp)
+    # The killed run's lock file stays behind: stale, taken over.
+    p = run(*base, "--steps", "2", "--out", folder)
+    check("fem_bench: a lock left by a run that is gone is taken over",
+          p.returncode == 0 and "taken over" in p.stdout, p.stdout + p.stderr)
+    check("fem_bench: a new run does not claim to replace anything", "replac" not in p.stdout, p.stdout)
+    p = run(*base, "--steps", "2", "--out", folder)
+    check("fem_bench: a finished run is not replaced without --replace",
+          p.returncode == 2 and "holds an earlier run" in p.stderr, p.stderr)
+    (folder / "phases.png").write_bytes(b"the earlier run's plot")
+    before = snapshot(folder)
+    p = run(*base, "--steps", "2", "--out", folder, "--replace", env={"FEM_FAIL_WRITES": "bench.json"})
+    check("fem_bench: a failed write exits non-zero, naming the path and the cause",
+          p.returncode == 1 and f"cannot write '{folder / 'bench.json'}': No space left" in p.stderr,
+          p.stdout + p.stderr)
+    check("fem_bench: ... and does not say 'wrote'", "wrote" not in p.stdout, p.stdout)
+    check("fem_bench: the folder a failed write touched is byte-identical", snapshot(folder) == before,
+          sorted(snapshot(folder)))
+    p = run(*base, "--steps", "2", "--out", folder, "--replace")
+    check("fem_bench: --replace replaces a finished run and says so",
+          p.returncode == 0 and "(--replace: replaced the run that was there, and its plots)" in p.stdout,
+          p.stdout + p.stderr)
+    check("fem_bench: no temporary or lock file left", sorted(snapshot(folder)) == ["bench.json"],
+          sorted(snapshot(folder)))
+
+
+def sim_cases(sim, tmp):
+    base = [sim, "--mesh", MESH, "--chapter", "01"]
+    folder = tmp / "sim_out"
+    second_run_refused("fem_sim", base + ["--steps", "1000000", "--every", "100000", "--out", folder],
+                       base + ["--steps", "2", "--out", folder], folder, tmp)
+    p = run(*base, "--steps", "4", "--out", folder)
+    check("fem_sim: a run after the first ended writes its series", p.returncode == 0, p.stdout + p.stderr)
+    before = snapshot(folder)
+    p = run(*base, "--steps", "4", "--out", folder, env={"FEM_FAIL_WRITES": "cantilever_000000.vtu"})
+    check("fem_sim: a failed frame write exits non-zero, naming the path and the cause",
+          p.returncode == 1 and "cantilever_000000.vtu': No space left" in p.stderr, p.stdout + p.stderr)
+    check("fem_sim: no temporary file left", all(not n.startswith(".") for n in snapshot(folder)),
+          sorted(snapshot(folder)))
+    check("fem_sim: the series is the earlier run's whole pvd",
+          snapshot(folder).get("cantilever.pvd") == before["cantilever.pvd"], sorted(snapshot(folder)))
+
+
+def long_run_case(bench, tmp):
+    out = tmp / "long.log"
+    with open(out, "w") as log:
+        p = holder([bench, "--mesh", MESH, "--chapters", "01", "--no-solvers", "--no-json",
+                    "--warmup", "1000000", "--steps", "10"], log)
+        try:
+            said = wait_for(out, "this run will take about", seconds=300)
+        finally:
+            p.kill()
+            p.wait()
+    text = out.read_text()
+    check("fem_bench --warmup 1000000: says how long before it goes on, into a file", said, text)
+    check("fem_bench --warmup 1000000: the header reaches the file", "fem_bench: scene" in text, text)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--bench", required=True)
+    parser.add_argument("--sim", required=True)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        bench_cases(args.bench, tmp)
+        sim_cases(args.sim, tmp)
+        long_run_case(args.bench, tmp)
+    print(f"{results['passed']} passed, {results['failed']} failed")
+    return 1 if results["failed"] or not results["passed"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
