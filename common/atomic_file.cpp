@@ -61,6 +61,18 @@ void write_file_atomically(const std::string& path, const std::string& text) {
   if (::rename(temporary.c_str(), target.c_str()) != 0) fail(errno);
 }
 
+void check_writable(const std::string& path) {
+  const fs::path target(path);
+  std::error_code error;
+  if (fs::is_directory(target, error))
+    throw WriteError("cannot write '" + path + "': it is a directory");
+  const fs::path temporary = temporary_name(target);
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) throw WriteError("cannot write '" + path + "': " + std::strerror(errno));
+  ::close(fd);
+  ::unlink(temporary.c_str());
+}
+
 void write_file_atomically(const std::string& path,
                            const std::function<void(std::ostream&)>& write) {
   std::ostringstream text;

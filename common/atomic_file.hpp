@@ -27,4 +27,9 @@ void write_file_atomically(const std::string& path,
 // The same for text already made.
 void write_file_atomically(const std::string& path, const std::string& text);
 
+// Before the work: tries what the write will do (makes the temporary name in the folder and
+// removes it again), so that a run does not end in "cannot write". Throws WriteError with the
+// path and the cause: no such folder, a directory, no permission, a read-only file system.
+void check_writable(const std::string& path);
+
 }  // namespace fem

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
 
@@ -233,7 +234,7 @@ void write_between_markers(const std::string& path, const std::string& name,
   if (b == std::string::npos || e == std::string::npos || e < b)
     throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
   doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
-  std::ofstream(path) << doc;
+  write_file_atomically(path, doc);
 }
 
 void announce_long_run(const std::string& program, double seconds_per_step, long long steps) {

@@ -4,7 +4,7 @@
 fem_bench and fem_sim into a folder another run is writing are refused before any work,
 naming it; --replace replaces a finished run only and says so only then; a write that fails
 (FEM_FAIL_WRITES, a full disk injected) exits non-zero with the path and the cause and
-leaves the folder byte-identical; a run of more than a minute says how long before it goes on,
+leaves the folder byte-identical; fem_viewer checks its output files before the work; a run of more than a minute says how long before it goes on,
 and its lines reach a file. Prints 'N passed, M failed' last.
 
     test_run_folders.py --bench build/release/fem_bench --sim build/release/fem_sim"""
@@ -127,16 +127,30 @@ def long_run_case(bench, tmp):
     check("fem_bench --warmup 1000000: the header reaches the file", "fem_bench: scene" in text, text)
 
 
+def viewer_cases(viewer, tmp):
+    """fem_viewer's output files are checked before the work: before the window, so the
+    refusal is the same with a display and without one."""
+    for option, path, cause in [("--screenshot", "/nonexistent_folder/shot.png", "No such file or directory"),
+                                ("--report", tmp, "it is a directory")]:
+        p = run(viewer, "--mesh", MESH, "--frames", "2", option, path)
+        check(f"fem_viewer {option}: an unwritable path is refused before the work",
+              p.returncode == 2 and f"{option}: cannot write '{path}': {cause}" in p.stderr
+              and "fem_viewer: cantilever" not in p.stdout, p.stdout + p.stderr)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--bench", required=True)
     parser.add_argument("--sim", required=True)
+    parser.add_argument("--viewer", help="fem_viewer, where it was built")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
         bench_cases(args.bench, tmp)
         sim_cases(args.sim, tmp)
         long_run_case(args.bench, tmp)
+        if args.viewer:
+            viewer_cases(args.viewer, tmp)
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] or not results["passed"] else 0
 
