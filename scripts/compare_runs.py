@@ -18,7 +18,7 @@ import pathlib
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from results_common import (BASELINE, PHASE_LABELS, PHASES, ResultsError,  # noqa: E402
+from results_common import (BASELINE, PHASE_LABELS, PHASES, ResultsError, replacing,  # noqa: E402
                             cache_summary, die, load_checked, machine_summary)
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -127,7 +127,8 @@ def plot(rows, differences, run_name, reference_name, path):
     fig.text(0.01, 0.005, f"what differs ({run_name} | {reference_name}): {note}", fontsize=6.5,
              color="0.35", ha="left", va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.05, 1, 1))
-    fig.savefig(path, dpi=110)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
 
 

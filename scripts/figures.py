@@ -30,7 +30,7 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.patches import FancyArrowPatch, Rectangle  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from results_common import ResultsError, die, load  # noqa: E402
+from results_common import ResultsError, die, load, replacing  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DATA = ROOT / "docs" / "data" / "figures"
@@ -44,7 +44,8 @@ def finish(fig, path, note, top=0.95, left=0.0):
     lines = textwrap.wrap(note, int(16 * fig.get_figwidth()))  # about 16 characters an inch
     fig.text(0.01, 0.008, "\n".join(lines), fontsize=7.5, color="0.35")
     fig.tight_layout(rect=(left, (0.1 + 0.14 * len(lines)) / fig.get_figheight(), 1, top))
-    fig.savefig(path, dpi=130)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
 

@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from results_common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,  # noqa: E402
                             POSTER_SOLVE_MS, ResultsError, chapter_color, chapter_dir,
-                            comparable_to_poster, die, footer, load_checked, run_label)
+                            comparable_to_poster, die, footer, load_checked, replacing, run_label)
 
 
 def finish(fig, data, path):
@@ -32,7 +32,8 @@ def finish(fig, data, path):
     if problems:
         plt.close(fig)
         raise ResultsError(f"{path.name}: the layout hides what it shows: " + "; ".join(problems))
-    fig.savefig(path, dpi=130)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
 

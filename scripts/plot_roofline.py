@@ -19,6 +19,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import replacing  # noqa: E402
+
 MARKERS = {"forces": "o", "dfdx": "s", "compose": "^", "constraints": "v", "solve": "D"}
 
 
@@ -86,7 +89,8 @@ def main():
     legend(fig, chapters, colours, meshes)
     fig.tight_layout(rect=(0, 0, 1 - 2.0 / fig.get_figwidth(), 1))
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=130)
+    with replacing(args.out) as tmp:
+        fig.savefig(tmp, dpi=130)
     print(f"wrote {args.out}")
     return 0
 

@@ -22,6 +22,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import write_text  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 DEFAULT_MESHES = ["plate_poster", "beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
 
@@ -107,7 +110,7 @@ def main():
         record = {"schema_version": 1, "lesson": "pyamg", "chapter": "10_multigrid",
                   "readme": "chapters/10_multigrid/README.md", "marker": "pyamg-table",
                   "command": "scripts/pyamg_reference.py " + " ".join(sys.argv[1:]), "table": table}
-        pathlib.Path(args.json).write_text(json.dumps(record, indent=2) + "\n")
+        write_text(args.json, json.dumps(record, indent=2) + "\n")
         print(f"wrote {args.json}")
 
 

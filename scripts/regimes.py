@@ -24,7 +24,8 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from regimes_common import (HEADER_KEYS, POSTER_NUMBERS, SHARE_PHASES, body_points,  # noqa: E402
                             chapter_names, iterations, share, solver_ratio, speedup,
                             validate_regimes)
-from results_common import BASELINE, PHASE_LABELS, ResultsError, die, footer, load  # noqa: E402
+from results_common import (BASELINE, PHASE_LABELS, ResultsError, die, footer, load,  # noqa: E402
+                            replacing, write_text)
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BODIES = ["meshes/plate_poster.msh", "meshes/perforated_bar_poster.msh"]
@@ -190,7 +191,8 @@ def plot(data, path):
              fontsize=6.5, color="0.35", ha="left", va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.04, 1, 0.97))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
     print(f"wrote {path}")
 
@@ -223,7 +225,7 @@ def main():
     else:
         data = sweep(args)
         args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(data, indent=1) + "\n")
+        write_text(args.out, json.dumps(data, indent=1) + "\n")
         print(f"wrote {args.out}")
         out_png = args.plot or args.out.with_name("regimes.png")
     problems = validate_regimes(data)

@@ -18,6 +18,9 @@ import numpy as np  # noqa: E402
 from matplotlib import animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import replacing  # noqa: E402
+
 
 def data_array(text, name):
     match = re.search(rf'<DataArray[^>]*Name="{name}"[^>]*>(.*?)</DataArray>', text, re.S)
@@ -81,7 +84,8 @@ def main():
 
     anim = animation.FuncAnimation(fig, draw, frames=len(frames))
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    anim.save(args.out, writer=animation.PillowWriter(fps=args.fps))
+    with replacing(args.out) as tmp:
+        anim.save(tmp, writer=animation.PillowWriter(fps=args.fps))
     print(f"wrote {args.out} ({len(frames)} frames)")
 
 

@@ -13,6 +13,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import write_text  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 COMMITTED = ["beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
 LARGE = ["beam_20k", "beam_50k", "beam_100k"]
@@ -86,7 +89,7 @@ def main():
               "uncommitted": header.get("uncommitted"), "budget_seconds": args.budget, "runs": runs, "skipped": skipped}
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(result, indent=1) + "\n")
+    write_text(out, json.dumps(result, indent=1) + "\n")
     print(f"wrote {out}")
 
 

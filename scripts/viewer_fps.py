@@ -17,6 +17,9 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from results_common import write_text  # noqa: E402
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 PAUSED = "paused"
@@ -90,7 +93,7 @@ def main():
                   flush=True)
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"schema_version": 1, "commit": git_commit(), "frames": args.frames,
+    write_text(out, json.dumps({"schema_version": 1, "commit": git_commit(), "frames": args.frames,
                                "runs": runs}, indent=2) + "\n")
     print(f"wrote {out}")
 

@@ -138,6 +138,26 @@ def viewer_cases(viewer, tmp):
               and "fem_viewer: cantilever" not in p.stdout, p.stdout + p.stderr)
 
 
+def plot_case(tmp):
+    """The Python writers go through one helper (scripts/results_common.py replacing): a plot
+    whose write fails leaves the earlier one."""
+    folder = tmp / "plots"
+    folder.mkdir()
+    (folder / "phases.png").write_bytes(b"the earlier plot")
+    plot = [sys.executable, ROOT / "scripts" / "plot_results.py", ROOT / "tests" / "fixtures" / "bench_fixture.json",
+            "--out", folder]
+    p = run(*plot, env={"FEM_FAIL_WRITES": "phases.png"})
+    check("plot_results.py: a failed plot write exits non-zero, naming the path and the cause",
+          p.returncode == 1 and f"cannot write '{folder / 'phases.png'}': No space left" in p.stderr,
+          p.stdout + p.stderr)
+    check("plot_results.py: ... the earlier plot intact, no temporary left",
+          snapshot(folder) == {"phases.png": b"the earlier plot"}, sorted(snapshot(folder)))
+    p = run(*plot)
+    check("plot_results.py: the plots written whole otherwise",
+          p.returncode == 0 and (folder / "phases.png").read_bytes().startswith(b"\x89PNG")
+          and not any(n.startswith(".") for n in snapshot(folder)), p.stdout + p.stderr)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--bench", required=True)
@@ -149,6 +169,7 @@ def main():
         bench_cases(args.bench, tmp)
         sim_cases(args.sim, tmp)
         long_run_case(args.bench, tmp)
+        plot_case(tmp)
         if args.viewer:
             viewer_cases(args.viewer, tmp)
     print(f"{results['passed']} passed, {results['failed']} failed")
