@@ -53,7 +53,7 @@ def main():
               and (student / "bench.json").read_bytes() == first, p.stdout[-300:] + p.stderr)
         p = run(*bench, "--out", student, "--no-solvers", "--replace")
         check("--replace replaces it and says so",
-              p.returncode == 0 and "replacing the run that was there" in p.stdout, p.stdout[-300:])
+              p.returncode == 0 and "replaced the run that was there" in p.stdout, p.stdout[-300:])
         p = run(*bench, "--out", student, "--replace")  # the hand-in: a full run again
         first = (student / "bench.json").read_bytes()
 
