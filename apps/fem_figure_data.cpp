@@ -98,6 +98,7 @@ int main(int argc, char** argv) {
     args.option("json", "FILE", "where to write the JSON", "");
     if (!args.parse(argc - 1, argv + 1)) return 0;
     if (args.get("json").empty()) throw UsageError("--json FILE is required");
+    apply_thread_environment();
     const Scene scene = scene_from_args(args);
     write_file_atomically(args.get("json"), [&](std::ostream& out) {
       out << "{\n" << mesh_record(args, scene) << "  \"figure\": " << json_string(what) << ",\n";

@@ -208,6 +208,15 @@ void add_thread_option(ArgParser& args) {
               "");
 }
 
+void apply_thread_environment() {
+  try {
+    if (const std::string warning = check_thread_environment(); !warning.empty())
+      std::cerr << "warning: " << warning << "\n";
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 int threads_from_args(const ArgParser& args) {
   if (const std::string& value = args.get("threads"); !value.empty()) {
     const int n = args.get_int("threads");
@@ -218,6 +227,8 @@ int threads_from_args(const ArgParser& args) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--threads: ") + e.what());
     }
+  } else {
+    apply_thread_environment();
   }
   return max_threads();
 }

@@ -17,6 +17,7 @@ namespace {
 // "1,2,4" -> {1, 2, 4}; empty -> 1 and OpenMP's count (OMP_NUM_THREADS or every core).
 std::vector<int> parse_thread_counts(const std::string& list) {
   if (list.empty()) {
+    apply_thread_environment();
     std::vector<int> out = {1};
     if (max_threads() > 1) out.push_back(max_threads());
     return out;
