@@ -158,6 +158,25 @@ def plot_case(tmp):
           and not any(n.startswith(".") for n in snapshot(folder)), p.stdout + p.stderr)
 
 
+def tutorial_sim_case(sim, tmp):
+    """./tutorial.sh sim writes its run's folder and no tracked file (the gif in the docs is
+    ./tutorial.sh docs's). Run with the preset the tests were built with (build/PRESET/)."""
+    build = pathlib.Path(sim).resolve().parent
+    if build.parent != ROOT / "build":
+        print(f"skip ./tutorial.sh sim: the build {build} is not one of the script's presets")
+        return
+    gif = ROOT / "docs" / "images" / "cantilever.gif"
+    before = gif.read_bytes()
+    folder = tmp / "tutorial_sim"
+    p = subprocess.run([ROOT / "tutorial.sh", "sim", "--mesh", MESH, "--steps", "4", "--out", folder],
+                       capture_output=True, text=True, cwd=ROOT,
+                       env={**os.environ, "PRESET": build.name, "FEM_SKIP_PACKAGES": "1"})
+    check("./tutorial.sh sim: the frames and the gif in the run's folder",
+          p.returncode == 0 and (folder / "cantilever.gif").read_bytes().startswith(b"GIF"),
+          p.stdout[-2000:] + p.stderr)
+    check("./tutorial.sh sim: docs/images/cantilever.gif untouched", gif.read_bytes() == before)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--bench", required=True)
@@ -170,6 +189,7 @@ def main():
         sim_cases(args.sim, tmp)
         long_run_case(args.bench, tmp)
         plot_case(tmp)
+        tutorial_sim_case(args.sim, tmp)
         if args.viewer:
             viewer_cases(args.viewer, tmp)
     print(f"{results['passed']} passed, {results['failed']} failed")
