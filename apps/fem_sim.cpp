@@ -64,11 +64,12 @@ void print_progress(int k, const Run& run, const Scene& scene, const StepProfile
 }
 
 // The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
-// for a step that diverged (an error) or left the body implausible (counted).
+// for a step that diverged (an error) or that left the body in trouble (common/deformation.hpp).
 void simulate(const Run& run, const Scene& scene, Stepper& stepper,
               std::optional<VtkSeries>& series) {
   State state = rest_state(scene);
   if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+  const DeformationProbe probe(scene);
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
   for (int k = 1; k <= run.steps; ++k) {
@@ -83,7 +84,7 @@ void simulate(const Run& run, const Scene& scene, Stepper& stepper,
     if (const char* why = divergence(state, stepper.profile()))
       throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" + why +
                                "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
-    deformation.after_step(k, check_deformation(scene.mesh, state.x));
+    deformation.after_step(k, probe.check(state));
     if (series && k % run.every == 0)
       series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
     if (k % report_every == 0 || k == run.steps) print_progress(k, run, scene, stepper.profile());
