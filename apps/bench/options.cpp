@@ -114,7 +114,7 @@ void add_bench_options(ArgParser& args) {
   args.option("out", "DIR",
               "the run's folder: writes DIR/bench.json (default: a new folder "
               "results/run-DATE-TIME, and results/latest points to it); a folder that holds a "
-              "run is refused unless --replace",
+              "run is refused unless --replace, a folder another run is writing always",
               "");
   args.flag("replace", "replace the run (bench.json and its plots) in --out DIR or at --json FILE");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
