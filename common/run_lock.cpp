@@ -50,7 +50,11 @@ std::string now() {
 RunLock::RunLock(const std::string& folder, const std::string& program, const std::string& name)
     : folder_(folder), path_((fs::path(folder) / name).string()) {
   std::error_code error;
-  made_folder_ = fs::create_directories(folder, error);
+  // The folders this lock makes, deepest first: removed again when the run leaves them empty.
+  for (fs::path p = fs::absolute(folder, error); !p.empty() && !fs::exists(p, error);
+       p = p.parent_path())
+    made_.push_back(p);
+  fs::create_directories(folder, error);
   if (error || !fs::is_directory(folder))
     throw std::runtime_error("cannot create the folder '" + folder +
                              "': " + (error ? error.message() : "not a directory"));
@@ -58,7 +62,7 @@ RunLock::RunLock(const std::string& folder, const std::string& program, const st
     acquire(program);
   } catch (...) {
     if (fd_ >= 0) ::close(fd_);
-    if (made_folder_) fs::remove(folder, error);
+    remove_made_folders();
     throw;
   }
 }
@@ -91,7 +95,7 @@ RunLock::RunLock(RunLock&& other) noexcept
     : folder_(std::move(other.folder_)),
       path_(std::move(other.path_)),
       fd_(other.fd_),
-      made_folder_(other.made_folder_),
+      made_(std::move(other.made_)),
       stale_pid_(other.stale_pid_) {
   other.fd_ = -1;
 }
@@ -100,8 +104,13 @@ RunLock::~RunLock() {
   if (fd_ < 0) return;
   ::unlink(path_.c_str());  // removed while still locked: no other run can take this file
   ::close(fd_);
+  remove_made_folders();
+}
+
+void RunLock::remove_made_folders() const {
   std::error_code error;
-  if (made_folder_ && fs::is_empty(folder_, error)) fs::remove(folder_, error);
+  for (const fs::path& p : made_)
+    if (!fs::is_empty(p, error) || !fs::remove(p, error)) return;
 }
 
 }  // namespace fem

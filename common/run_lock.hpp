@@ -6,8 +6,10 @@
 // gone is stale and is taken over.
 #pragma once
 
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace fem {
 
@@ -24,8 +26,8 @@ class RunLock {
   // holds it, std::runtime_error when the folder cannot be made or the lock file written.
   RunLock(const std::string& folder, const std::string& program,
           const std::string& name = ".fem_run.lock");
-  // Removes the lock file, and the folder when this lock made it and it is still empty (a run
-  // that failed before its first result leaves no empty folder).
+  // Removes the lock file, and the folders this lock made that are still empty (a run that
+  // failed before its first result leaves no empty folder behind).
   ~RunLock();
   RunLock(RunLock&& other) noexcept;
   RunLock(const RunLock&) = delete;
@@ -37,10 +39,11 @@ class RunLock {
 
  private:
   void acquire(const std::string& program);
+  void remove_made_folders() const;
 
   std::string folder_, path_;
   int fd_ = -1;
-  bool made_folder_ = false;
+  std::vector<std::filesystem::path> made_;
   long stale_pid_ = 0;
 };
 

@@ -53,6 +53,10 @@ TEST_CASE("run lock: a second run into a locked folder is refused, naming the fi
   CHECK_FALSE(fs::exists(dir));
   const RunLock again(dir.string(), "fem_bench");
   CHECK(again.stale_pid() == 0);
+  // Nested folders the lock made are all removed again when the run leaves them empty.
+  { const RunLock nested((dir / "a" / "b").string(), "fem_sim"); }
+  CHECK(fs::is_directory(dir));
+  CHECK_FALSE(fs::exists(dir / "a"));
 }
 
 TEST_CASE("run lock: a lock file whose run is gone is stale and taken over", "[run]") {
