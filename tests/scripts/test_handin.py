@@ -13,6 +13,8 @@ import subprocess
 import sys
 import tempfile
 
+from femtools.course import handin as check_handin
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PLOTS = ["phases.png", "speedup.png", "allocations.png", "solvers.png"]
 results = {"passed": 0, "failed": 0}
@@ -71,9 +73,7 @@ def main():
               f"{folders} {p.stderr}")
 
         # The JSON ties each chapter's row to its sources: the hash the build recorded equals the
-        # one the hand-in check computes from the folder (scripts/check_handin.py).
-        sys.path.insert(0, str(ROOT / "scripts"))
-        import check_handin  # noqa: E402
+        # one the hand-in check computes from the folder (fem-tools course handin).
         rows = json.loads((student / "bench.json").read_text())["chapters"]
         check("each row records the hash of its chapter's sources, as the hand-in check computes it",
               all(r.get("source_hash") == check_handin.source_hash(ROOT / "chapters" / r["chapter"])
@@ -96,7 +96,7 @@ def main():
         teacher = tmp / "teacher"
         teacher.mkdir()
         (teacher / "bench.json").write_bytes(first)
-        p = run(ROOT / ".venv" / "bin" / "python", ROOT / "scripts" / "plot_results.py",
+        p = run(sys.executable, "-m", "femtools", "plots", "bench",
                 teacher / "bench.json", "--out", teacher)
         check("the teacher's regeneration exits 0", p.returncode == 0, p.stderr)
         for png in PLOTS:

@@ -1,0 +1,1 @@
+"""The plots and figures, drawn from the committed data (matplotlib, Agg)."""
