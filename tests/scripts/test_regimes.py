@@ -16,7 +16,9 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+from femtools.docs import regime_tables
 from femtools.docs import update as update_docs
+from femtools.results import poster
 from femtools.results import regimes as regimes_common
 
 results = {"passed": 0, "failed": 0}
@@ -76,11 +78,11 @@ def main():
 
         # The generated sections: one row per poster number, from this JSON.
         statements = regimes_common.poster_statements(data)
-        for _, label, target in regimes_common.POSTER_NUMBERS:
+        for _, label, target in poster.NUMBERS:
             check(f"the statements name the poster's x{target:g}", f"x{target:g}" in statements)
-        table = update_docs.regimes_points_table(data)
+        table = regime_tables.regimes_points_table(data)
         check("the points table has a row per point", table.count("`test_beam`") == 2, table)
-        solvers = update_docs.regimes_solvers_table(data)
+        solvers = regime_tables.regimes_solvers_table(data)
         check("the solve table shows the softest and the stiffest point",
               f"E = {SOFT:g}" in solvers and f"E = {STIFF:g}" in solvers, solvers)
         repo = tmp / "repo"

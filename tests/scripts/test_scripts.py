@@ -13,9 +13,11 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
-from femtools.docs import update as update_docs
+from femtools.docs import markdown
 from femtools.plots import bench as plot_results
-from femtools.results.common import chapter_dir, footer, validate_bench, validate_viewer
+from femtools.plots import style as plot_style
+from femtools.results.common import chapter_dir, footer
+from femtools.results.schema import validate_bench, validate_viewer
 
 results = {"passed": 0, "failed": 0}
 
@@ -124,7 +126,7 @@ def main():
         ax.legend(loc="center")
         fig.canvas.draw()
         check("the layout check finds a legend that covers bars",
-              any("legend" in problem for problem in plot_results.layout_problems(fig)))
+              any("legend" in problem for problem in plot_style.layout_problems(fig)))
         plt.close(fig)
         two = copy.deepcopy(bench)
         two["chapters"] = [c for c in bench["chapters"] if c["chapter"] != "01_naive"][:2]
@@ -139,7 +141,7 @@ def main():
               all(min(p) >= 0 and abs(sum(p) - max(step, sum(p[:-1]))) < 1e-9 for _, p, step in rows),
               str(rows[:2]))
         check("rows on two threads are hatched, rows on one are not",
-              all((plot_results.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
+              all((plot_style.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
                   for c in bench["chapters"]) and any(c.get("threads", 1) > 1 for c in bench["chapters"]))
 
         # A run folder holds one run's files: a run without a solve table removes the old one.
@@ -181,7 +183,7 @@ def main():
         check("chapter 02's table has one speedup row (over 01, its previous chapter)",
               chapter02.count("| speedup over `01_naive` |") == 1)
         tampered = (root / "docs" / "results.md").read_text().replace(
-            update_docs.ms(bench["chapters"][0]["median_ms"]["step"]), "1234.5", 1)
+            markdown.ms(bench["chapters"][0]["median_ms"]["step"]), "1234.5", 1)
         (root / "docs" / "results.md").write_text(tampered)
         p = run("docs", "update", "--root", root, "--check")
         check("fem-tools docs update --check fails on a hand-edited number", p.returncode == 1 and
@@ -191,9 +193,9 @@ def main():
         naive = next(c for c in bench["chapters"] if c["chapter"] == "01_naive")
         last = bench["chapters"][-1]
         for phase in ["dfdx", "solve", "step"]:
-            text = update_docs.ms(naive["median_ms"][phase])
+            text = markdown.ms(naive["median_ms"][phase])
             check(f"results.md shows 01's {phase} median {text}", text in results_md)
-        speed = update_docs.ratio(naive["median_ms"]["step"], last["median_ms"]["step"])
+        speed = markdown.ratio(naive["median_ms"]["step"], last["median_ms"]["step"])
         check(f"results.md shows the step speedup {speed}", speed in results_md)
         check("results.md shows the poster's x218.79", "x218.79" in results_md)
         check("results.md names the machine", bench["machine"]["cpu"] in results_md)
@@ -201,20 +203,20 @@ def main():
               all(f"`{s['name']}`" in results_md for s in bench["solvers"]))
         check("results.md shows the scaling table", "stopped" in results_md)
         readme = (root / "README.md").read_text()
-        check("README headline filled", update_docs.ms(last["median_ms"]["step"]) in readme)
+        check("README headline filled", markdown.ms(last["median_ms"]["step"]) in readme)
         check("results.md viewer table filled",
               "| drawing only (`--paused`) | 31.2 | - |" in results_md and "llvmpipe (fixture)" in results_md and
-              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {update_docs.ms(r['mean_step_ms'])} |"
+              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {markdown.ms(r['mean_step_ms'])} |"
                   in results_md for r in viewer["runs"][1:]), results_md[results_md.find("viewer-fps"):][:600])
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
-        check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
+        check("chapter 01 table filled", markdown.ms(naive["median_ms"]["forces"]) in chapter)
         threaded = [c for c in bench["chapters"] if "@" in c["chapter"]]
         chapter = (root / "chapters" / "09_threads" / "README.md").read_text()
         check("chapter 09 tables filled: NAME@N rows and the thread table",
               all(f"bench-table:{c['chapter']}:begin -->\n| median ms" in chapter for c in threaded) and
               "threads-table:begin -->\n| median ms" in chapter and
-              all(update_docs.ms(c["median_ms"]["step"]) in chapter for c in threaded),
+              all(markdown.ms(c["median_ms"]["step"]) in chapter for c in threaded),
               chapter[chapter.find("measured effect"):][:800])
         check("README links NAME@N rows to the chapter's directory",
               "[`09_threads@2`](chapters/09_threads/README.md)" in readme)

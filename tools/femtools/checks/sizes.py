@@ -4,7 +4,9 @@
   - no function (or lambda at file scope) in chapters/, common/ or apps/ over 60 lines, counted
     from the line of its opening brace to the line of its closing one;
   - no struct or class of chapters 09 on with more than 17 data members (the steppers of the
-    chapters before, which hold the buffers of a step each named in its comment, are exempt).
+    chapters before, which hold the buffers of a step each named in its comment, are exempt);
+  - the same for the Python of tools/femtools/ and meshes/: no file over 400 lines, no function
+    (def, at any depth) over 60 lines, from its `def` line to its last line (Python's own parser).
 
 The parser is a brace matcher, not a compiler: comments, string literals and preprocessor
 lines are blanked first; a `{` at namespace or class scope opens a namespace, a type (class,
@@ -18,15 +20,18 @@ is two.
     fem-tools check sizes --root DIR
 """
 import argparse
+import ast
 import pathlib
 import re
 import sys
 
 from femtools.paths import ROOT
+
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 60
 MAX_DATA_MEMBERS = 17
 FIRST_CHAPTER_WITH_MEMBER_LIMIT = 9
+PYTHON_FOLDERS = ("tools/femtools", "meshes")
 
 TOKEN = re.compile(r'//[^\n]*|/\*.*?\*/|"(?:[^"\\\n]|\\.)*"|\'(?:[^\'\\\n]|\\.)*\'', re.S)
 PREPROCESSOR = re.compile(r"^[ \t]*#(?:[^\n]*\\\n)*[^\n]*", re.M)
@@ -185,6 +190,26 @@ def check_file(path, root, chapter):
     return problems + scan(blank(text), rel, lines_of, limit_members)
 
 
+def check_python(path, root):
+    """A Python file's findings: its length, and each function's from its `def` to its last line."""
+    text = path.read_text()
+    rel = path.relative_to(root)
+    problems = []
+    if text.count("\n") > MAX_FILE_LINES:
+        problems.append(f"{rel}: {text.count(chr(10))} lines (at most {MAX_FILE_LINES})")
+    for node in ast.walk(ast.parse(text, str(rel))):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            length = node.end_lineno - node.lineno + 1
+            if length > MAX_FUNCTION_LINES:
+                problems.append(f"{rel}:{node.lineno}: {node.name} is {length} lines long "
+                                f"(at most {MAX_FUNCTION_LINES})")
+    return problems
+
+
+def python_sources(root):
+    return [p for folder in PYTHON_FOLDERS for p in sorted((root / folder).rglob("*.py")) if p.is_file()]
+
+
 def sources(root):
     """(path, chapter number or None) of every C++ source the limits hold for."""
     for folder in ("chapters", "common", "apps"):
@@ -201,12 +226,13 @@ def main(argv=None, prog=None):
     parser.add_argument("--root", type=pathlib.Path, default=ROOT)
     root = parser.parse_args(argv).root
     found = [(p, check_file(p, root, chapter)) for p, chapter in sources(root)]
+    found += [(p, check_python(p, root)) for p in python_sources(root)]
     problems = [problem for _, some in found for problem in some]
     print("\n".join(problems), file=sys.stderr, end="\n" if problems else "")
     if problems:
         print(f"fem-tools check sizes: {len(problems)} finding(s) in {len(found)} files", file=sys.stderr)
         return 1
-    print(f"fem-tools check sizes: {len(found)} files: none over {MAX_FILE_LINES} lines in chapters/, no "
+    print(f"fem-tools check sizes: {len(found)} files: none over {MAX_FILE_LINES} lines in chapters/ or in Python, no "
           f"function over {MAX_FUNCTION_LINES} lines, no type of chapters 09 on with more than "
           f"{MAX_DATA_MEMBERS} data members")
     return 0

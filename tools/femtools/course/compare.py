@@ -15,8 +15,9 @@ marked difference; exits 0 (a comparison, not a check) unless a file cannot be r
 import argparse
 import pathlib
 
-from femtools.results.common import (BASELINE, PHASE_LABELS, PHASES, ResultsError,
-                            cache_summary, die, load_checked, machine_summary)
+from femtools.results.common import BASELINE, ResultsError, cache_summary, die, machine_summary
+from femtools.results.phases import PHASE_LABELS, compared
+from femtools.results.schema import load_checked
 
 from femtools.paths import ROOT
 REFERENCE = ROOT / "docs" / "data" / "bench.json"
@@ -61,7 +62,7 @@ def speedups(data):
         return {}
     out = {}
     for name, c in rows.items():
-        for phase in PHASES:
+        for phase in compared(data):
             med, q1, q3 = (c[key][phase] for key in ("median_ms", "q1_ms", "q3_ms"))
             b_med, b_q1, b_q3 = (base[key][phase] for key in ("median_ms", "q1_ms", "q3_ms"))
             if min(med, q1, b_med, b_q1) > 0:
@@ -75,7 +76,7 @@ def compare(run, reference):
     ours, theirs = speedups(run), speedups(reference)
     rows = []
     for c in run["chapters"]:
-        for phase in PHASES if c["chapter"] != BASELINE else []:
+        for phase in compared(run) if c["chapter"] != BASELINE else []:
             key = (c["chapter"], phase)
             if key in ours and key in theirs:
                 a, b = ours[key], theirs[key]
@@ -83,24 +84,23 @@ def compare(run, reference):
     return rows
 
 
-def print_table(rows):
+def print_table(rows, phases):
     chapters = list(dict.fromkeys(r[0] for r in rows))
     cell = {(r[0], r[1]): f"{r[2][0]:.2f} | {r[3][0]:.2f}{' *' if r[4] else '  '}" for r in rows}
     width = max(len(c) for c in chapters) + 2
     print(f"\nspeedup over {BASELINE} (median step of each phase), this run | the reference; "
           "* : the two differ by more than their quartile ranges")
-    print("chapter".ljust(width) + "".join(PHASE_LABELS[p][:19].ljust(21) for p in PHASES))
+    print("chapter".ljust(width) + "".join(PHASE_LABELS.get(p, p)[:19].ljust(21) for p in phases))
     for chapter in chapters:
         print(chapter.ljust(width) +
-              "".join(cell.get((chapter, p), "-").ljust(21) for p in PHASES))
+              "".join(cell.get((chapter, p), "-").ljust(21) for p in phases))
 
 
-def plot(rows, differences, run_name, reference_name, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def plot(rows, phases, differences, run_name, reference_name, path):
+    from femtools.plots import pyplot
+    plt = pyplot()
     import numpy as np
-    shown = [p for p in PHASES if any(r[1] == p for r in rows)]
+    shown = [p for p in phases if any(r[1] == p for r in rows)]
     fig, axes = plt.subplots(len(shown), 1, figsize=(10, 2.2 * len(shown) + 1), squeeze=False)
     for ax, phase in zip(axes[:, 0], shown):
         mine = [r for r in rows if r[1] == phase]
@@ -148,7 +148,7 @@ def main(argv=None, prog=None):
     rows = compare(run, reference)
     if not rows:
         die(f"no chapter measured in both runs with {BASELINE} beside it: nothing to compare")
-    print_table(rows)
+    print_table(rows, compared(run))
     marked = [r for r in rows if r[4]]
     print(f"\n{len(marked)} of {len(rows)} speedups differ by more than the runs' spread"
           + (": look at what differs in the records above" if marked and differences else ""))
@@ -157,6 +157,6 @@ def main(argv=None, prog=None):
               f"{b[0]:.2f} [{b[1]:.2f}-{b[2]:.2f}] in the reference")
     out = args.out or paths[0].parent
     out.mkdir(parents=True, exist_ok=True)
-    plot(rows, differences, "this run", "the reference", out / "compare.png")
+    plot(rows, compared(run), differences, "this run", "the reference", out / "compare.png")
     print(f"wrote {out / 'compare.png'}")
     return 0

@@ -8,54 +8,14 @@
 import argparse
 import pathlib
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from femtools.results.common import (BASELINE, PHASE_LABELS, PHASES, POSTER_SPEEDUPS,
-                            POSTER_SOLVE_MS, ResultsError, chapter_color, chapter_dir,
-                            comparable_to_poster, die, footer, load_checked, run_label)
-
-
-def finish(fig, data, path):
-    text = footer(data)
-    busy = "BUSY MACHINE" in text
-    fig.text(0.01, 0.005, text, fontsize=6.5, color="firebrick" if busy else "0.35", ha="left",
-             va="bottom", wrap=True)
-    fig.tight_layout(rect=(0, 0.08 if busy else 0.05, 1, 1))
-    problems = layout_problems(fig)
-    if problems:
-        plt.close(fig)
-        raise ResultsError(f"{path.name}: the layout hides what it shows: " + "; ".join(problems))
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    print(f"wrote {path}")
-
-
-def layout_problems(fig):
-    """What a reader could not read, found from the drawn figure: a legend box over a bar or
-    a marker of its axes, and tick labels of one axis that run into each other."""
-    renderer = fig.canvas.get_renderer()
-    problems = []
-    for ax in fig.axes:
-        legend = ax.get_legend()
-        if legend is not None:
-            box = legend.get_window_extent(renderer)
-            covered = [a for a in list(ax.patches) + list(ax.collections)
-                       if a.get_visible() and a.get_window_extent(renderer).overlaps(box)
-                       and a.get_window_extent(renderer).width > 0]
-            if covered:
-                problems.append(f"the legend of '{ax.get_title()}' covers {len(covered)} marks")
-        for axis, name in ((ax.xaxis, "x"), (ax.yaxis, "y")):
-            # Slanted labels (the allocation plot's) have boxes that overlap by design: their
-            # text runs parallel, apart. Only level labels are checked.
-            boxes = [t.get_window_extent(renderer) for t in axis.get_ticklabels(which="both")
-                     if t.get_visible() and t.get_text() and t.get_rotation() == 0]
-            if any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:]):
-                problems.append(f"the {name} tick labels of '{ax.get_title()}' overlap")
-    return problems
+from femtools.plots.style import finish, legend_outside, mark_zero, style
+from femtools.results import poster
+from femtools.results.common import BASELINE, ResultsError, chapter_color, chapter_dir, die, run_label
+from femtools.results.phases import PHASE_LABELS, all_phases, colour, parts
+from femtools.results.schema import load_checked
 
 
 def ratio_ticks(ax):
@@ -72,33 +32,9 @@ def chapter_labels(chapters):
     return [c["chapter"] for c in chapters]
 
 
-def style(c):
-    """A row's bar style: its chapter's colour (a variant in the light shade of its original's),
-    and a hatch for a row on more than one thread ("09_threads@2" beside "09_threads@1"), so that
-    the rows of one chapter at several thread counts can be told apart."""
-    threaded = c.get("threads", 1) > 1
-    return {"color": chapter_color(c["chapter"], c.get("variant_of", "")),
-            "hatch": "..." if threaded else None, "edgecolor": "white" if threaded else None,
-            "linewidth": 0}
-
-
-def legend_outside(ax, title=None):
-    """The legend right of the axes, where it covers no bar (the poster's hatched bars
-    included), one entry per row."""
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
-              title=title, title_fontsize=8)
-
-
-def mark_zero(ax, x, text="0"):
-    """A phase at 0 ms (a chapter that does not have it: chapter 08's fused pass builds no
-    df/dx) gets no bar on a log axis; a small mark at the bottom says that it is zero."""
-    ax.annotate(text, (x, 0), xycoords=ax.get_xaxis_transform(), xytext=(0, 2),
-                textcoords="offset points", ha="center", va="bottom", fontsize=6, color="0.3")
-
-
 def plot_phases(data, out):
     chapters = data["chapters"]
-    phases = ["forces"] + PHASES
+    phases = all_phases(data)
     x = np.arange(len(phases))
     width = 0.8 / len(chapters)
     fig, ax = plt.subplots(figsize=(12, 5))
@@ -123,21 +59,16 @@ def plot_phases(data, out):
     finish(fig, data, out / "phases.png")
 
 
-# The phases of the stacked bars, left to right, and their colours (one per phase, not per chapter).
-STACK_COLORS = {"forces": "tab:gray", "dfdx": "tab:orange", "compose": "tab:green",
-                "constraints": "tab:red", "solve": "tab:blue", "rest": "0.8"}
-
-
 def stacked_rows(data):
-    """Per row of the run: (label, the phases' medians in STACK_COLORS's order, the step's
+    """Per row of the run: (label, the phases' medians in the run's order and the rest, the step's
     median). "rest" is the step's median minus the phases' medians (the state update, the
     profiling itself, and the difference between a median of sums and a sum of medians),
     never drawn below 0."""
     rows = []
     for c in data["chapters"]:
         med = c["median_ms"]
-        parts = [med["forces"], med["dfdx"], med["compose"], med["constraints"], med["solve"]]
-        rows.append((c["chapter"], parts + [max(med["step"] - sum(parts), 0.0)], med["step"]))
+        times = [med[p] for p in parts(data)]
+        rows.append((c["chapter"], times + [max(med["step"] - sum(times), 0.0)], med["step"]))
     return rows
 
 
@@ -148,12 +79,13 @@ def plot_phases_stacked(data, out):
     fig, ax = plt.subplots(figsize=(11, 0.36 * len(rows) + 2.2))
     y = np.arange(len(rows))
     left = np.zeros(len(rows))
-    for k, phase in enumerate(STACK_COLORS):
+    for k, phase in enumerate(parts(data) + ["rest"]):
         widths = np.array([r[1][k] for r in rows])
         label = PHASE_LABELS.get(phase, "rest of the step")
         if phase == "forces":
             label = "forces (from 08: the fused element pass)"
-        ax.barh(y, widths, left=left, color=STACK_COLORS[phase], label=label, height=0.72)
+        ax.barh(y, widths, left=left, color=colour(phase) if phase != "rest" else "0.8", label=label,
+                height=0.72)
         left += widths
     base = rows[0][2]
     for yi, (_, _, step) in zip(y, rows):
@@ -204,9 +136,9 @@ def plot_speedup(data, out):
         finish(fig, data, out / "speedup.png")
         return
     # forces too: the same code up to chapter 07 (about x1), chapter 08's fused element pass after
-    phases = ["forces"] + PHASES
-    poster = comparable_to_poster(data) and pairs[0][1]["chapter"] == BASELINE
-    bars = len(pairs) + (1 if poster else 0)
+    phases = all_phases(data)
+    beside = poster.comparable(data) and pairs[0][1]["chapter"] == BASELINE
+    bars = len(pairs) + (1 if beside else 0)
     x = np.arange(len(phases))
     width = 0.8 / bars
     several = len({ref["chapter"] for _, ref in pairs}) > 1
@@ -221,9 +153,9 @@ def plot_speedup(data, out):
         for xp, v in zip(pos, s):
             if np.isnan(v):
                 mark_zero(ax, xp, "-")
-    if poster:
+    if beside:
         ax.bar(x + (len(pairs) - (bars - 1) / 2) * width,
-               [POSTER_SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
+               [poster.SPEEDUPS.get(p, np.nan) for p in phases], width, color="none",
                edgecolor="black", hatch="//", label="poster (optimized vs naive)")
     ax.axhline(1.0, color="0.3", lw=0.8)
     ax.set_yscale("log")
@@ -232,7 +164,7 @@ def plot_speedup(data, out):
     ax.set_xticks(x, [PHASE_LABELS[p].replace(" ", "\n", 1) for p in phases])
     ratio_ticks(ax)
     ax.set_ylabel(f"{ylabel} (median ratio, log)")
-    ax.set_title(title + (", beside the poster's" if poster else "") + f" ({run_label(data)})")
+    ax.set_title(title + (", beside the poster's" if beside else "") + f" ({run_label(data)})")
     legend_outside(ax, "-: a phase at 0 ms, no ratio")
     ax.grid(axis="y", which="both", alpha=0.3)
     finish(fig, data, out / "speedup.png")
@@ -282,10 +214,10 @@ def plot_solvers(data, out):
                  label="solve")
     else:
         ax1.barh(names, [s["median_ms"] for s in solvers], color="tab:blue", label="measured")
-    if comparable_to_poster(data):  # absolute times compare only on the poster's run
-        poster = [POSTER_SOLVE_MS.get(n) for n in names]
-        ys = [i for i, p in enumerate(poster) if p is not None]
-        ax1.scatter([poster[i] for i in ys], ys, marker="D", color="black", zorder=3,
+    if poster.comparable(data):  # absolute times compare only on the poster's run
+        reported = [poster.SOLVE_MS.get(n) for n in names]
+        ys = [i for i, p in enumerate(reported) if p is not None]
+        ax1.scatter([reported[i] for i in ys], ys, marker="D", color="black", zorder=3,
                     clip_on=False, label="poster")
     # A log axis: the solvers span two decades, and the poster's few milliseconds would sit
     # squashed against zero on a linear one. The legend below the axes covers no bar.
@@ -427,7 +359,3 @@ def main(argv=None, prog=None):
             plot_threads(load_checked(args.threads), out)
     except ResultsError as e:
         die(f"fem-tools plots bench: {e}")
-
-
-if __name__ == "__main__":
-    main()

@@ -9,13 +9,10 @@ import re
 import sys
 from collections import Counter
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib import animation  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib import animation
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 
 def data_array(text, name):
@@ -82,7 +79,3 @@ def main(argv=None, prog=None):
     args.out.parent.mkdir(parents=True, exist_ok=True)
     anim.save(args.out, writer=animation.PillowWriter(fps=args.fps))
     print(f"wrote {args.out} ({len(frames)} frames)")
-
-
-if __name__ == "__main__":
-    main()

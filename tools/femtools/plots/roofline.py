@@ -13,10 +13,8 @@ import pathlib
 import sys
 
 import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
 MARKERS = {"forces": "o", "dfdx": "s", "compose": "^", "constraints": "v", "solve": "D"}
 

@@ -3,24 +3,16 @@ check, the quantities read from it (chapter 01's CG iterations and phase shares,
 chapter 01, the solve table's ratios) and the generated statements that place each of the
 poster's six numbers in the regime where it holds. Shared by runs/regimes.py, docs/update.py and
 the tests; the schema is documented in README.md beside the bench schema."""
-from femtools.results.common import BASELINE, PHASE_LABELS, validate_bench
+from femtools.docs.markdown import table
+from femtools.results import poster
+from femtools.results.common import BASELINE
+from femtools.results.phases import parts
+from femtools.results.schema import validate_bench
 
-# The chapter the poster's "optimized" column corresponds to (its own PCG, zero allocations).
-POSTER_CHAPTER = "06_custom_pcg"
-# The poster's six numbers, as printed: four speedups of the optimized stepper over the naive
-# one per phase, and two of its solve table (times over Eigen's solve()).
-POSTER_NUMBERS = [
-    ("dfdx", "df/dx construction", 5.487),
-    ("compose", "system composition", 21.358),
-    ("constraints", "constraints", 218.79),
-    ("step", "overall step", 9.849),
-    ("eigen_cg_guess", "Eigen `solveWithGuess()` over `solve()`", 1.614),
-    ("pcg_ch06", "our PCG over Eigen's `solve()`", 4.226),
-]
-SOLVER_KEYS = {"eigen_cg_guess", "pcg_ch06"}
+SOLVER_KEYS = set(poster.SOLVE_RATIOS)
 # The phases that share chapter 01's step; "other" is the rest of the step (copies, the
 # velocity and position update, the profiler).
-SHARE_PHASES = ["forces", "dfdx", "compose", "constraints", "solve"]
+SHARE_PHASES = parts()
 HEADER_KEYS = ["scene", "steps", "warmup_steps", "dt", "cg_tolerance", "cg_max_iterations",
                "build", "machine", "commit", "schema_version"]
 
@@ -169,9 +161,9 @@ def poster_rows(data):
     """(poster number, who is measured, one phrase per body) for each of the six numbers."""
     rows = []
     bodies = data["bodies"]
-    have06 = chapter(data["points"][0], POSTER_CHAPTER) is not None
-    for key, label, target in POSTER_NUMBERS:
-        number = f"{PHASE_LABELS.get(key, label)} x{target:g}"
+    have06 = chapter(data["points"][0], poster.POSTER_CHAPTER) is not None
+    for key, label, target in poster.NUMBERS:
+        number = f"{label} x{target:g}"
         if key in SOLVER_KEYS:
             if all(p.get("solvers") for p in data["points"]):
                 rows.append((number, f"`{key}`, the same systems",
@@ -183,7 +175,7 @@ def poster_rows(data):
         if have06:
             rows.append((number, "chapter 06 (the poster's optimized stepper)",
                          [describe(body_points(data, b), target,
-                                   lambda p: (speedup(p, POSTER_CHAPTER, key), "")) for b in bodies]))
+                                   lambda p: (speedup(p, poster.POSTER_CHAPTER, key), "")) for b in bodies]))
         rows.append(("" if have06 else number, "the fastest chapter at each point",
                      [describe(body_points(data, b), target,
                                lambda p: (speedup(p, best_chapter(p, key), key), best_chapter(p, key)))
@@ -196,9 +188,9 @@ def poster_statements(data):
     and the solve's share of its step, per body) where the repository reaches it and where not,
     and the iteration count at which the overall step first reaches x9.849."""
     header = ["the poster's number", "measured"] + [f"`{b}`" for b in data["bodies"]]
-    lines = ["| " + " | ".join(header) + " |", "| " + " | ".join(["---"] * len(header)) + " |"]
-    lines += ["| " + " | ".join([number, who] + cells) + " |" for number, who, cells in poster_rows(data)]
-    target = next(t for k, _, t in POSTER_NUMBERS if k == "step")
+    lines = [table(header, [[number, who] + cells for number, who, cells in poster_rows(data)],
+                   ["---"] * len(header)).rstrip("\n")]
+    target = poster.number("step")
     hit = first_reached(data, "step", target)
     forces = sorted((share(p, "forces"), p) for p in data["points"])
     (low, p_low), (high, p_high) = forces[0], forces[-1]

@@ -7,7 +7,8 @@
 import argparse
 import sys
 
-from femtools.results.common import ResultsError, load, validate_bench, validate_scaling
+from femtools.results.common import ResultsError, load
+from femtools.results.schema import validate_bench, validate_scaling
 from femtools.results.regimes import validate_regimes
 
 

@@ -117,7 +117,3 @@ def write_between_markers(path, name, text):
     if b < 0 or e < b:
         raise SystemExit(f"pyamg_reference: {path} has no markers {begin} ... {end}")
     path.write_text(doc[:b + len(begin)] + "\n" + text + doc[e:])
-
-
-if __name__ == "__main__":
-    main()

@@ -18,12 +18,10 @@ import subprocess
 import tempfile
 import time
 
-from femtools.results.regimes import (HEADER_KEYS, POSTER_NUMBERS, SHARE_PHASES, body_points,
-                            chapter_names, iterations, share, solver_ratio, speedup,
-                            validate_regimes)
-from femtools.results.common import BASELINE, PHASE_LABELS, ResultsError, die, footer, load
-
 from femtools.paths import ROOT
+from femtools.results.common import BASELINE, ResultsError, die, load
+from femtools.results.regimes import HEADER_KEYS, chapter_names, iterations, share, speedup, validate_regimes
+
 BODIES = ["meshes/plate_poster.msh", "meshes/perforated_bar_poster.msh"]
 # Half-decade steps (1, 3, 10, ...) over four and a half decades: from a soft body that chapter 01's
 # CG solves in a handful of iterations to a stiff one that takes it hundreds (beyond, the stiff
@@ -95,103 +93,6 @@ def sweep(args):
     return result
 
 
-def chapter_colours(names):
-    import matplotlib.pyplot as plt
-    cmap = plt.get_cmap("tab10" if len(names) <= 10 else "tab20")
-    return {n: cmap(i % cmap.N) for i, n in enumerate(names)}
-
-
-BODY_STYLES = [("-", "o"), ("--", "s"), (":", "^"), ("-.", "D")]
-# The solve table's two ratios the poster reports: colour, what the solver is.
-SOLVER_LINES = {"eigen_cg_guess": ("tab:orange", "Eigen solveWithGuess()"), "pcg_ch06": ("tab:purple", "ours")}
-
-
-def poster_number(key):
-    return next(target for k, _, target in POSTER_NUMBERS if k == key)
-
-
-def plot(data, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.lines import Line2D
-    from matplotlib.ticker import FuncFormatter
-
-    names = chapter_names(data)
-    colours = chapter_colours(names)
-    styles = {b: BODY_STYLES[i % len(BODY_STYLES)] for i, b in enumerate(data["bodies"])}
-    have_solvers = all(p.get("solvers") for p in data["points"])
-    fig, axes = plt.subplots(1, 3 if have_solvers else 2, figsize=(18 if have_solvers else 13, 5.8))
-    ax_step, ax_share = axes[0], axes[-1]
-
-    for body in data["bodies"]:
-        pts = body_points(data, body)
-        xs = [iterations(p) for p in pts]
-        line, marker = styles[body]
-        for n in names:
-            if n != BASELINE:
-                ax_step.plot(xs, [speedup(p, n) for p in pts], line, marker=marker, ms=4, color=colours[n])
-        for i, phase in enumerate(SHARE_PHASES + ["other"]):
-            ax_share.plot(xs, [100 * share(p, phase) for p in pts], line, marker=marker, ms=4,
-                          color=plt.get_cmap("Dark2")(i))
-        if have_solvers:
-            for key, (colour, _) in SOLVER_LINES.items():
-                axes[1].plot(xs, [solver_ratio(p, key) for p in pts], line, marker=marker, ms=4, color=colour)
-    step_target = poster_number("step")
-    ax_step.axhline(step_target, color="black", lw=1.2, ls=(0, (6, 3)))
-    ax_step.annotate(f"poster x{step_target:g}", (0.01, step_target), xycoords=("axes fraction", "data"),
-                     va="bottom", fontsize=8)
-    ax_step.axhline(1.0, color="0.5", lw=0.7)
-    ax_step.set_yscale("log")
-    ax_step.set_ylabel(f"overall step speedup over {BASELINE} (median ratio, log)")
-    ax_step.set_title("Overall step: speedup over chapter 01")
-    chapter_handles = [Line2D([], [], color=colours[n], label=n) for n in names if n != BASELINE]
-    body_handles = [Line2D([], [], color="0.3", ls=styles[b][0], marker=styles[b][1], label=b)
-                    for b in data["bodies"]]
-    ax_step.legend(handles=chapter_handles + body_handles, fontsize=7, ncol=2)
-
-    if have_solvers:
-        ax = axes[1]
-        for key, (colour, _) in SOLVER_LINES.items():
-            target = poster_number(key)
-            ax.axhline(target, color=colour, lw=1.0, ls=(0, (6, 3)))
-            ax.annotate(f"poster x{target:g}", (0.01, target), xycoords=("axes fraction", "data"),
-                        va="bottom", fontsize=8, color=colour)
-        ax.axhline(1.0, color="0.5", lw=0.7)
-        ax.set_yscale("log")
-        ax.set_ylabel("Eigen solve() time over the solver's (median ratio, log)")
-        ax.set_title("The solve table: the same systems, the same tolerance")
-        ax.legend(handles=[Line2D([], [], color=c, label=f"{key} ({what})")
-                           for key, (c, what) in SOLVER_LINES.items()] + body_handles, fontsize=7)
-
-    ax_share.set_ylabel("share of chapter 01's median step [%]")
-    ax_share.set_ylim(0, 100)
-    ax_share.set_title("Where chapter 01's step goes (Amdahl: what is left to gain)")
-    ax_share.legend(handles=[Line2D([], [], color=plt.get_cmap("Dark2")(i),
-                                    label=PHASE_LABELS.get(ph, "other (update, copies)"))
-                             for i, ph in enumerate(SHARE_PHASES + ["other"])] + body_handles, fontsize=7)
-    for ax in axes[:-1]:  # ratios on a log scale, labelled as plain ratios
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"x{v:g}"))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"x{v:g}" if str(v)[0] in "235" else ""))
-    for ax in axes:
-        ax.set_xscale("log")
-        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.xaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:g}" if str(v)[0] in "25" else ""))
-        ax.set_xlabel("chapter 01's CG iterations per step (median, log)")
-        ax.grid(which="both", alpha=0.3)
-    e = data["E_values"]
-    fig.suptitle(f"Regimes: Young's modulus E from {min(e):g} to {max(e):g} Pa at dt = {data['dt']:g} s; "
-                 "the stiffer, the more CG iterations", fontsize=10)
-    head = dict(data, mesh=None, steps=data["steps"])
-    fig.text(0.01, 0.005, f"{', '.join(data['bodies'])}, {data['steps']} steps per point | " + footer(head),
-             fontsize=6.5, color="0.35", ha="left", va="bottom", wrap=True)
-    fig.tight_layout(rect=(0, 0.04, 1, 0.97))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    print(f"wrote {path}")
-
-
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fem_bench"), help="fem_bench binary")
@@ -226,8 +127,5 @@ def main(argv=None, prog=None):
     problems = validate_regimes(data)
     if problems:
         die("fem-tools runs regimes: the sweep does not match its schema:\n  " + "\n  ".join(problems))
+    from femtools.plots.regimes import plot  # matplotlib only here: --help and a sweep run without it
     plot(data, out_png)
-
-
-if __name__ == "__main__":
-    main()

@@ -22,7 +22,7 @@ def mesh_path(name):
     return committed if committed.exists() else ROOT / "meshes" / "generated" / f"{name}.msh"
 
 
-def main(argv=None, prog=None):
+def arguments(argv, prog):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fem_bench"))
     parser.add_argument("--out", default=str(ROOT / "results" / "scaling.json"))
@@ -34,14 +34,22 @@ def main(argv=None, prog=None):
     args = parser.parse_args(argv)
     if args.steps <= 0 or args.warmup < 1 or args.budget <= 0:
         parser.error("--steps, --warmup and --budget must be positive (the first step allocates the steppers' buffers)")
+    return args
 
-    names = COMMITTED + ([] if args.no_large else LARGE)
+
+def generate_missing(names):
+    """The large beams are generated on demand (gmsh), not committed."""
     missing = [n for n in names if not mesh_path(n).exists()]
     if missing:
         print(f"generating {', '.join(missing)} (gmsh)", flush=True)
         subprocess.run([sys.executable, str(ROOT / "meshes" / "generate.py"), "--only", *missing],
                        check=True)
 
+
+def main(argv=None, prog=None):
+    args = arguments(argv, prog)
+    names = COMMITTED + ([] if args.no_large else LARGE)
+    generate_missing(names)
     listing = subprocess.run([args.bench, "--help"], capture_output=True, text=True, check=True)
     del listing  # fem_bench exists and runs
     chapters = None if args.chapters == "all" else args.chapters.split(",")
@@ -87,7 +95,3 @@ def main(argv=None, prog=None):
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {out}")
-
-
-if __name__ == "__main__":
-    main()

@@ -92,7 +92,3 @@ def main(argv=None, prog=None):
     out.write_text(json.dumps({"schema_version": 1, "commit": git_commit(), "frames": args.frames,
                                "runs": runs}, indent=2) + "\n")
     print(f"wrote {out}")
-
-
-if __name__ == "__main__":
-    main()
