@@ -14,11 +14,10 @@ are covered as soon as they exist) and every .cpp/.hpp in it:
     fem-tools check chapter-sources --root DIR
 """
 import argparse
-import pathlib
 import re
 import sys
 
-from femtools.paths import ROOT
+from femtools.paths import add_root_option
 
 CHAPTER_DIR = re.compile(r"^(\d\d)_[A-Za-z0-9_]+$")
 STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"')
@@ -64,8 +63,7 @@ def check_file(path, nn):
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--root", type=pathlib.Path,
-                        default=ROOT)
+    add_root_option(parser)
     args = parser.parse_args(argv)
     chapters = sorted(d for d in (args.root / "chapters").iterdir()
                       if d.is_dir() and CHAPTER_DIR.match(d.name))

@@ -15,11 +15,11 @@ carries `<!-- not measured: REASON -->` on one of the two lines before it.
     fem-tools check doc-numbers      # exit 1 and the tables, if any
 """
 import argparse
-import pathlib
 import re
 
-from femtools.paths import ROOT
-BEGIN = re.compile(r"<!-- (\S+):begin -->")
+from femtools.docs.markers import BEGIN
+from femtools.paths import add_root_option
+
 ALLOW = re.compile(r"<!-- not measured: \S.*-->")
 UNIT = r"(?:ms|us|µs|ns|s|%|B|KB|kB|KiB|MB|MiB|GB|GiB|GB/s|MB/s|frames/s)"
 MEASURED = re.compile(
@@ -98,7 +98,7 @@ def main(argv=None, prog=None):
     self_test()
     parser = argparse.ArgumentParser(prog=prog, description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("root", nargs="?", type=pathlib.Path, default=ROOT, help="repository root")
+    add_root_option(parser)
     root = parser.parse_args(argv).root
     problems = [f"{path.relative_to(root)}:{line}: a table with a measured number ({number}) "
                 f"outside the generated markers"

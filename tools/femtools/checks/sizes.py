@@ -21,11 +21,10 @@ is two.
 """
 import argparse
 import ast
-import pathlib
 import re
 import sys
 
-from femtools.paths import ROOT
+from femtools.paths import add_root_option
 
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 60
@@ -223,7 +222,7 @@ def sources(root):
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT)
+    add_root_option(parser)
     root = parser.parse_args(argv).root
     found = [(p, check_file(p, root, chapter)) for p, chapter in sources(root)]
     found += [(p, check_python(p, root)) for p in python_sources(root)]

@@ -21,7 +21,7 @@ import subprocess
 import tempfile
 
 from femtools.docs import diffs
-from femtools.paths import ROOT, subcommand
+from femtools.paths import ROOT, add_root_option, subcommand
 
 
 class Checks:
@@ -109,7 +109,7 @@ def main(argv=None, prog=None):
     parser.add_argument("--variant", action="append", default=[], help="the variant to check (default: every variant the run measured)")
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build" / "release", help="the build whose tests run")
     parser.add_argument("--no-tests", action="store_true", help="skip the variant's tests")
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT, help=argparse.SUPPRESS)
+    add_root_option(parser, hidden=True)
     args = parser.parse_args(argv)
     json_path = args.folder / "bench.json"
     if not json_path.is_file():

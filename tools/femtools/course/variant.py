@@ -8,12 +8,11 @@ The copy's namespace fem::ch06 becomes fem::ch06_my_fused_updates (both are link
 same programs), its includes of its own headers point to the copy, its README's heading names
 it, and chapters/06_my_fused_updates/variant_of names the original."""
 import argparse
-import pathlib
 import re
 import shutil
 import sys
 
-from femtools.paths import ROOT
+from femtools.paths import add_root_option
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
@@ -84,7 +83,7 @@ def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("chapter", help="the number of the chapter to copy, e.g. 06")
     parser.add_argument("name", help="the variant's name, e.g. my_fused_updates")
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT, help=argparse.SUPPRESS)
+    add_root_option(parser, hidden=True)
     args = parser.parse_args(argv)
     try:
         original, variant = make_variant(args.root, args.chapter, args.name)

@@ -25,7 +25,7 @@ import subprocess
 import sys
 import time
 
-from femtools.paths import ROOT
+from femtools.paths import add_root_option
 
 MANIFEST = pathlib.Path("docs/data/book.json")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"((?:chapters|common)/[^"]+)"', re.MULTILINE)
@@ -145,7 +145,7 @@ def problems(root):
 
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT)
+    add_root_option(parser)
     sub = parser.add_subparsers(dest="command", required=True)
     write = sub.add_parser("manifest", help="write docs/data/book.json after a sitting")
     write.add_argument("--started", type=float, required=True, help="the sitting's start (epoch s)")

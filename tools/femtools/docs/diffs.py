@@ -21,7 +21,8 @@ import re
 import sys
 
 from femtools.course import variant as make_variant
-from femtools.paths import ROOT
+from femtools.docs.markers import replace_between
+from femtools.paths import add_root_option
 STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
 
@@ -176,18 +177,14 @@ def files_table(dirs):
 
 def with_files_table(text, table):
     """chapters/README.md's text with the table between its markers (None: no markers)."""
-    begin, end = f"<!-- {FILES_MARKER}:begin -->", f"<!-- {FILES_MARKER}:end -->"
-    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
-    if not pattern.search(text):
-        return None
-    return pattern.sub(lambda _: begin + "\n" + table + end, text)
+    return replace_between(text, FILES_MARKER, table)
 
 
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true", help="only check that the diffs are current")
     parser.add_argument("--variant", help="print a variant's change against its original instead")
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT)
+    add_root_option(parser)
     args = parser.parse_args(argv)
     if args.variant:
         sys.stdout.write(variant_diff(args.root, args.variant))

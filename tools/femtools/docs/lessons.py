@@ -9,11 +9,10 @@ no number of a lesson is typed by hand or left behind by a rerun.
 """
 import argparse
 import json
-import pathlib
-import re
 import sys
 
-from femtools.paths import ROOT
+from femtools.docs.markers import replace_between
+from femtools.paths import add_root_option
 FIELDS = ("lesson", "readme", "marker", "command", "table")
 
 
@@ -25,18 +24,10 @@ def load(path):
     return data
 
 
-def replace(text, marker, body):
-    begin, end = f"<!-- {marker}:begin -->", f"<!-- {marker}:end -->"
-    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
-    if not pattern.search(text):
-        return None
-    return pattern.sub(lambda _: begin + "\n" + body + end, text)
-
-
 def main(argv=None, prog=None):
     parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true", help="only check the READMEs")
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT)
+    add_root_option(parser)
     args = parser.parse_args(argv)
     paths = sorted((args.root / "docs" / "data" / "lessons").glob("*.json"))
     if not paths:
@@ -47,7 +38,7 @@ def main(argv=None, prog=None):
         data = load(path)
         readme = args.root / data["readme"]
         text = readme.read_text()
-        new = replace(text, data["marker"], data["table"])
+        new = replace_between(text, data["marker"], data["table"])
         if new is None:
             problems.append(f"{data['readme']} has no {data['marker']} markers (from {path.name})")
         elif new != text:

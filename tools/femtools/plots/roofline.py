@@ -16,7 +16,10 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
-MARKERS = {"forces": "o", "dfdx": "s", "compose": "^", "constraints": "v", "solve": "D"}
+from femtools.results.phases import marker, parts
+
+# One marker per phase of the step (results/phases.py).
+MARKERS = {p: marker(p) for p in parts()}
 
 
 def roofs(ax, roof, x):
