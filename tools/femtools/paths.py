@@ -1,7 +1,6 @@
 """Where the repository is. The package lives in tools/femtools/ of the repository it serves,
 so every command reads and writes the tree it was run from: a copy of the repository (as the
 coursework tests make) runs its own tools on itself."""
-import argparse
 import os
 import pathlib
 import sys
@@ -15,10 +14,3 @@ def subcommand(*args):
     own package first on the path, whatever .venv has installed)."""
     path = os.pathsep.join(p for p in (str(TOOLS), os.environ.get("PYTHONPATH")) if p)
     return [sys.executable, "-m", "femtools", *map(str, args)], dict(os.environ, PYTHONPATH=path)
-
-
-def add_root_option(parser, hidden=False):
-    """The one --root of the commands that work on a repository: another checkout than this
-    package's (a copy of the repository, as the tests make)."""
-    parser.add_argument("--root", type=pathlib.Path, default=ROOT,
-                        help=argparse.SUPPRESS if hidden else "the repository (default: this package's)")

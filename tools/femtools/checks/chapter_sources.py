@@ -13,11 +13,11 @@ are covered as soon as they exist) and every .cpp/.hpp in it:
     fem-tools check chapter-sources            # exit 1 on any finding
     fem-tools check chapter-sources --root DIR
 """
-import argparse
 import re
 import sys
 
-from femtools.paths import add_root_option
+from femtools.args import command_parser, add_root_option
+
 
 CHAPTER_DIR = re.compile(r"^(\d\d)_[A-Za-z0-9_]+$")
 STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"')
@@ -61,8 +61,7 @@ def check_file(path, nn):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     add_root_option(parser)
     args = parser.parse_args(argv)
     chapters = sorted(d for d in (args.root / "chapters").iterdir()

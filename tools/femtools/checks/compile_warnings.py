@@ -15,7 +15,6 @@ depth (CI's clang preset at x86-64-v3), is checked without compiling it again. E
 The default compiler is CMake's (GCC on Debian); with --cxx the build folders are named after
 it (build/march-clang++-x86-64-v3), so the two never share a CMake cache.
 """
-import argparse
 import json
 import os
 import pathlib
@@ -23,6 +22,7 @@ import shlex
 import subprocess
 import time
 
+from femtools.args import command_parser
 from femtools.paths import ROOT
 
 
@@ -60,7 +60,7 @@ def compile_objects(build_dir, objects, jobs):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--march", action="append", help="target level (repeatable); "
                         "default x86-64-v3 and x86-64-v4")
     parser.add_argument("--build-root", type=pathlib.Path, default=ROOT / "build")

@@ -14,11 +14,10 @@ carries `<!-- not measured: REASON -->` on one of the two lines before it.
 
     fem-tools check doc-numbers      # exit 1 and the tables, if any
 """
-import argparse
 import re
 
+from femtools.args import command_parser, add_root_option
 from femtools.docs.markers import BEGIN
-from femtools.paths import add_root_option
 
 ALLOW = re.compile(r"<!-- not measured: \S.*-->")
 UNIT = r"(?:ms|us|µs|ns|s|%|B|KB|kB|KiB|MB|MiB|GB|GiB|GB/s|MB/s|frames/s)"
@@ -96,8 +95,7 @@ def too_long(root):
 
 def main(argv=None, prog=None):
     self_test()
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     add_root_option(parser)
     root = parser.parse_args(argv).root
     problems = [f"{path.relative_to(root)}:{line}: a table with a measured number ({number}) "

@@ -19,12 +19,12 @@ is two.
     fem-tools check sizes              # exit 1 on any finding
     fem-tools check sizes --root DIR
 """
-import argparse
 import ast
 import re
 import sys
 
-from femtools.paths import add_root_option
+from femtools.args import command_parser, add_root_option
+
 
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 60
@@ -220,8 +220,7 @@ def sources(root):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     add_root_option(parser)
     root = parser.parse_args(argv).root
     found = [(p, check_file(p, root, chapter)) for p, chapter in sources(root)]

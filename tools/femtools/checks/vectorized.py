@@ -14,7 +14,6 @@ into a select's arm, which -ftrapping-math forbids to run for every lane unless 
 masks can hide it), and nothing but a report says so.
 
 """
-import argparse
 import json
 import re
 import shlex
@@ -22,6 +21,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from femtools.args import command_parser
 
 
 def simd_loops(lines):
@@ -85,8 +86,7 @@ def report(build_dir: Path, source: Path):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("build_dir", type=Path, help="the build folder (its compile_commands.json)")
     parser.add_argument("source", type=Path, help="the source file whose loops are checked")
     args = parser.parse_args(argv)

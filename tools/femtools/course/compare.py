@@ -12,9 +12,9 @@ run, the mesh and the scene. A plot of both runs' speedups goes beside RUN (comp
 
 Prints the records' differences, the table and one line "differs: CHAPTER PHASE ..." per
 marked difference; exits 0 (a comparison, not a check) unless a file cannot be read."""
-import argparse
 import pathlib
 
+from femtools.args import command_parser
 from femtools.results.common import BASELINE, ResultsError, cache_summary, die, machine_summary
 from femtools.results.phases import PHASE_LABELS, compared
 from femtools.results.schema import load_checked
@@ -129,7 +129,7 @@ def plot(rows, phases, differences, run_name, reference_name, path):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("run", help="a run's folder or its bench.json")
     parser.add_argument("reference", nargs="?", default=str(REFERENCE),
                         help="another run (default: the committed docs/data/bench.json)")

@@ -13,15 +13,15 @@ For each variant of the run (a chapter whose folder has a variant_of file):
 And for the run: the plots regenerate from the JSON alone, pixel for pixel as handed in, and a
 run measured on a busy machine is named (its ratios are not to be graded: ask for a rerun).
 Prints one line per check and 'N passed, M failed' last; exits 1 on a failure."""
-import argparse
 import hashlib
 import json
 import pathlib
 import subprocess
 import tempfile
 
+from femtools.args import command_parser, add_root_option
 from femtools.docs import diffs
-from femtools.paths import ROOT, add_root_option, subcommand
+from femtools.paths import ROOT, subcommand
 
 
 class Checks:
@@ -104,7 +104,7 @@ def check_plots(check, folder):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("folder", type=pathlib.Path, help="the run's folder handed in (bench.json, plots)")
     parser.add_argument("--variant", action="append", default=[], help="the variant to check (default: every variant the run measured)")
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build" / "release", help="the build whose tests run")

@@ -7,12 +7,12 @@ check it (tests/generic/), and the generated-diff check leaves it out.
 The copy's namespace fem::ch06 becomes fem::ch06_my_fused_updates (both are linked into the
 same programs), its includes of its own headers point to the copy, its README's heading names
 it, and chapters/06_my_fused_updates/variant_of names the original."""
-import argparse
 import re
 import shutil
 import sys
 
-from femtools.paths import add_root_option
+from femtools.args import command_parser, add_root_option
+
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
@@ -80,7 +80,7 @@ def make_variant(root, number, name):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("chapter", help="the number of the chapter to copy, e.g. 06")
     parser.add_argument("name", help="the variant's name, e.g. my_fused_updates")
     add_root_option(parser, hidden=True)

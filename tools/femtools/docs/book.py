@@ -16,7 +16,6 @@ names the chapter and the command that records the book again.
     fem-tools docs book check [--root DIR]
     fem-tools docs book estimate [--root DIR]     # the last sitting's stage times, one 'name seconds' a line
     fem-tools docs book code-hash CHAPTER [...]   # the hash of one chapter's code, and the files it covers"""
-import argparse
 import hashlib
 import json
 import pathlib
@@ -25,7 +24,8 @@ import subprocess
 import sys
 import time
 
-from femtools.paths import add_root_option
+from femtools.args import add_root_option, command_parser
+
 
 MANIFEST = pathlib.Path("docs/data/book.json")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"((?:chapters|common)/[^"]+)"', re.MULTILINE)
@@ -144,7 +144,7 @@ def problems(root):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0])
+    parser = command_parser(prog, __doc__.split("\n\n")[0])
     add_root_option(parser)
     sub = parser.add_subparsers(dest="command", required=True)
     write = sub.add_parser("manifest", help="write docs/data/book.json after a sitting")

@@ -14,15 +14,14 @@ that table is stale or any hunk only changes names.
     fem-tools docs diffs --check            # compare with the committed ones
     fem-tools docs diffs --variant 10_mine  # a variant against its original
 """
-import argparse
 import difflib
 import pathlib
 import re
 import sys
 
+from femtools.args import command_parser, add_root_option
 from femtools.course import variant as make_variant
 from femtools.docs.markers import replace_between
-from femtools.paths import add_root_option
 STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
 
@@ -181,7 +180,7 @@ def with_files_table(text, table):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--check", action="store_true", help="only check that the diffs are current")
     parser.add_argument("--variant", help="print a variant's change against its original instead")
     add_root_option(parser)

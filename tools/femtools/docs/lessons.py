@@ -7,12 +7,11 @@ no number of a lesson is typed by hand or left behind by a rerun.
     fem-tools docs lessons            # write the tables into the READMEs
     fem-tools docs lessons --check    # are the READMEs those of the JSON?
 """
-import argparse
 import json
 import sys
 
+from femtools.args import command_parser, add_root_option
 from femtools.docs.markers import replace_between
-from femtools.paths import add_root_option
 FIELDS = ("lesson", "readme", "marker", "command", "table")
 
 
@@ -25,7 +24,7 @@ def load(path):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--check", action="store_true", help="only check the READMEs")
     add_root_option(parser)
     args = parser.parse_args(argv)

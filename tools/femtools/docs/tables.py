@@ -241,6 +241,14 @@ def readme_title(root, name, fallback):
     return fallback
 
 
+# The phases a fused element pass (chapter 08 on) does the work of, in its forces phase.
+FUSED = ("forces", "dfdx", "compose")
+
+
+def fused_ms(row):
+    return sum(row["median_ms"][p] for p in FUSED)
+
+
 def chapter_map(data):
     """One line per chapter: the idea, the phase it moves most, the overall step speedup."""
     by = chapters_by_name(data)
@@ -253,9 +261,7 @@ def chapter_map(data):
         if ref is not None and c["median_ms"]["dfdx"] == 0 < ref["median_ms"]["dfdx"]:
             # A fused element pass (chapter 08) has no df/dx phase of its own: compare the three
             # phases it replaces together, not a zero.
-            fused = ("forces", "dfdx", "compose")
-            moved = (f"forces + df/dx + composition (fused) "
-                     f"{ratio(sum(ref['median_ms'][p] for p in fused), sum(c['median_ms'][p] for p in fused))} "
+            moved = (f"forces + df/dx + composition (fused) {ratio(fused_ms(ref), fused_ms(c))} "
                      f"over `{ref['chapter']}`")
         elif ref is not None:
             moved = moved_most(c, ref, parts(data))
@@ -278,16 +284,15 @@ def chapter_table(data, name):
             [f"{x['allocations_per_step']:g}", f"{x['cg_iterations']:g}"] for x in shown]
     refs = [r for r in (by.get(BASELINE), previous) if r is not None and r is not c]
     for ref in [r for i, r in enumerate(refs) if r not in refs[:i]]:  # 02: previous is 01
-            rows.append([f"speedup over `{ref['chapter']}`"] +
-                        [ratio(ref["median_ms"][p], c["median_ms"][p]) for p in all_phases(data)] + ["", ""])
+        rows.append([f"speedup over `{ref['chapter']}`"] +
+                    [ratio(ref["median_ms"][p], c["median_ms"][p]) for p in all_phases(data)] + ["", ""])
     header = ["median ms"] + [PHASE_LABELS[p] for p in all_phases(data)] + ["allocations/step", "CG it."]
     fused_note = ""
     if previous is not None and c["median_ms"]["dfdx"] == 0 < previous["median_ms"]["dfdx"]:
         # A fused element pass has no df/dx phase: the three phases it replaces, summed.
-        fused = lambda x: sum(x["median_ms"][p] for p in ("forces", "dfdx", "compose"))  # noqa: E731
         fused_note = (f" Forces + df/dx construction + system composition, the work of the fused "
-                      f"element pass: {ms(fused(previous))} ms in `{previous['chapter']}`, "
-                      f"{ms(fused(c))} ms in `{c['chapter']}` ({ratio(fused(previous), fused(c))}).")
+                      f"element pass: {ms(fused_ms(previous))} ms in `{previous['chapter']}`, "
+                      f"{ms(fused_ms(c))} ms in `{c['chapter']}` ({ratio(fused_ms(previous), fused_ms(c))}).")
     return (table(header, rows) +
             f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; machine and flags in "
             f"[docs/results.md](../../docs/results.md).{fused_note} {NOTE}.\n")

@@ -21,15 +21,14 @@ writes nothing and fails when a generated section differs from what the committe
     fem-tools docs update --images docs/images   # also copy the plots
     fem-tools docs update --check          # are the docs those of docs/data?
 """
-import argparse
 import pathlib
 import shutil
 import sys
 
+from femtools.args import command_parser, add_root_option
 from femtools.docs import regime_tables, tables
 from femtools.docs.diffs import chapter_dirs
 from femtools.docs.markers import update_file
-from femtools.paths import add_root_option
 from femtools.results import regimes as regimes_common
 from femtools.results.common import ResultsError, chapter_dir, die, load
 from femtools.results.schema import load_checked
@@ -161,7 +160,7 @@ def copy_images(root, images, source_dir):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     add_root_option(parser)
     parser.add_argument("--bench", type=pathlib.Path, help="default: ROOT/docs/data/bench.json")
     parser.add_argument("--scaling", type=pathlib.Path, help="default: ROOT/docs/data/scaling.json if present")

@@ -5,12 +5,12 @@
     fem-tools plots bench --scaling results/scaling.json --out results   scaling
     fem-tools plots bench --threads results/threads.json --out results   threads (thread scaling)
 """
-import argparse
 import pathlib
 
 import matplotlib.pyplot as plt
 import numpy as np
 
+from femtools.args import command_parser
 from femtools.plots.style import finish, legend_outside, mark_zero, style
 from femtools.results import poster
 from femtools.results.common import BASELINE, ResultsError, chapter_color, chapter_dir, die, run_label
@@ -333,7 +333,7 @@ def plot_threads(data, out):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("bench", nargs="?", help="results/bench.json")
     parser.add_argument("--scaling", help="results/scaling.json")
     parser.add_argument("--threads", help="results/threads.json (fem_bench --threads 1,2,...)")

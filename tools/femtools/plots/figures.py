@@ -14,7 +14,6 @@ The meshes are read here with gmsh's Python API and numbered as common/mesh.cpp 
 (nodes by tag, unused nodes dropped); the JSON's tet checksum says whether that numbering is
 the code's. `./tutorial.sh lessons` writes the JSON, `./tutorial.sh docs` draws the figures.
 """
-import argparse
 import pathlib
 
 import matplotlib.pyplot as plt
@@ -22,6 +21,7 @@ import numpy as np
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.patches import FancyArrowPatch, Rectangle
 
+from femtools.args import command_parser
 from femtools.plots.lanes import plot_padded_lanes, plot_soa_batch
 from femtools.plots.style import PALETTE, finish_figure as finish
 from femtools.paths import ROOT
@@ -259,7 +259,7 @@ def plot_node_orders(d, out):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("figure", nargs="?", choices=["hierarchy", "node-orders", "lanes"],
                         help="one family of figures (default: all)")
     parser.add_argument("--data", type=pathlib.Path, default=DATA,

@@ -3,7 +3,6 @@ matplotlib: the boundary triangles of the tetrahedra, shaded by displacement.
 
     fem-tools plots gif out/sim/cantilever.pvd --out docs/images/cantilever.gif
 """
-import argparse
 import pathlib
 import re
 import sys
@@ -13,6 +12,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import animation
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+from femtools.args import command_parser
 
 
 def data_array(text, name):
@@ -39,7 +40,7 @@ def boundary(tets):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("pvd", type=pathlib.Path)
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("docs/images/cantilever.gif"))
     parser.add_argument("--fps", type=int, default=15)

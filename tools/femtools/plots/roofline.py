@@ -7,7 +7,6 @@ distance from the bound (Williams, Waterman & Patterson, CACM 52(4), 2009).
 
     fem-tools plots roofline results/roofline.json --out results/roofline.png
 """
-import argparse
 import json
 import pathlib
 import sys
@@ -16,6 +15,7 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
+from femtools.args import command_parser
 from femtools.results.phases import marker, parts
 
 # One marker per phase of the step (results/phases.py).
@@ -62,7 +62,7 @@ def legend(fig, chapters, colours, meshes):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("json", type=pathlib.Path)
     parser.add_argument("--out", type=pathlib.Path, required=True, help="the PNG to write")
     args = parser.parse_args(argv)

@@ -4,16 +4,16 @@
     fem-tools results validate --scaling results/scaling.json
     fem-tools results validate --regimes results/regimes.json
 """
-import argparse
 import sys
 
+from femtools.args import command_parser
 from femtools.results.common import ResultsError, load
 from femtools.results.schema import validate_bench, validate_scaling
 from femtools.results.regimes import validate_regimes
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("json")
     parser.add_argument("--scaling", action="store_true", help="the file is a scaling.json")
     parser.add_argument("--regimes", action="store_true", help="the file is a regimes.json")

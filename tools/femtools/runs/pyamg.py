@@ -14,13 +14,13 @@ on the same system, also from a zero guess.
 (the second also records the table, which fem-tools docs lessons writes into chapter 10's
 README between its pyamg-table markers)
 """
-import argparse
 import json
 import pathlib
 import subprocess
 import sys
 import tempfile
 
+from femtools.args import command_parser
 from femtools.docs.markdown import table
 from femtools.docs.markers import replace_between
 from femtools.paths import ROOT
@@ -57,8 +57,7 @@ def pyamg_iterations(folder, tol, modes):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--tool", default=str(ROOT / "build" / "release" / "fem_lessons"))
     parser.add_argument("--meshes", default=",".join(DEFAULT_MESHES), help="comma-separated")
     parser.add_argument("--scene", default="cantilever")

@@ -18,6 +18,7 @@ import subprocess
 import tempfile
 import time
 
+from femtools.args import command_parser
 from femtools.paths import ROOT
 from femtools.results.common import BASELINE, ResultsError, die, load
 from femtools.results.regimes import HEADER_KEYS, chapter_names, iterations, share, speedup, validate_regimes
@@ -94,7 +95,7 @@ def sweep(args):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fem_bench"), help="fem_bench binary")
     parser.add_argument("--bodies", nargs="+", default=BODIES, metavar="MSH",
                         help="meshes (default: the two poster-sized bodies)")

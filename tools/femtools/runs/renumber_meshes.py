@@ -5,10 +5,10 @@ where gmsh was built with it, Metis) into meshes/generated/NAME_METHOD.msh (git 
 
     fem-tools runs renumber-meshes                         # the default meshes
     fem-tools runs renumber-meshes --meshes plate_poster --methods RCMK"""
-import argparse
 import pathlib
 import sys
 
+from femtools.args import command_parser
 from femtools.paths import ROOT
 DEFAULT_MESHES = "plate_poster,beam_10k,beam_100k"
 METHODS = ("RCMK", "Hilbert", "Metis")
@@ -28,7 +28,7 @@ def renumber(gmsh, source, target, method):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--meshes", default=DEFAULT_MESHES,
                         help=f"comma-separated mesh names (default {DEFAULT_MESHES}); a missing "
                              "generated mesh is skipped with a note (./tutorial.sh meshes --large)")

@@ -4,7 +4,6 @@ chapter that exceeds it stops there, and the plot marks where.
 
     fem-tools runs scaling --bench build/release/fem_bench --out results/scaling.json
 """
-import argparse
 import json
 import pathlib
 import subprocess
@@ -12,6 +11,7 @@ import sys
 import tempfile
 import time
 
+from femtools.args import command_parser
 from femtools.paths import ROOT
 COMMITTED = ["beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
 LARGE = ["beam_20k", "beam_50k", "beam_100k"]
@@ -23,7 +23,7 @@ def mesh_path(name):
 
 
 def arguments(argv, prog):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fem_bench"))
     parser.add_argument("--out", default=str(ROOT / "results" / "scaling.json"))
     parser.add_argument("--chapters", default="all", help="comma-separated, or all")

@@ -8,7 +8,6 @@ README (the viewer-fps markers).
 Under Xvfb the OpenGL is Mesa's software renderer (llvmpipe), which draws on the same cores
 that step: the frame rates are a floor, and the report names the renderer.
 """
-import argparse
 import json
 import pathlib
 import shutil
@@ -16,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 
+from femtools.args import command_parser
 from femtools.paths import ROOT
 
 PAUSED = "paused"
@@ -58,7 +58,7 @@ def run_one(viewer, mesh, chapter, frames, size, report):
 
 
 def main(argv=None, prog=None):
-    parser = argparse.ArgumentParser(prog=prog, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = command_parser(prog, __doc__)
     parser.add_argument("--viewer", default=str(ROOT / "build" / "release" / "fem_viewer"))
     parser.add_argument("--mesh", default=str(ROOT / "meshes" / "plate_poster.msh"))
     parser.add_argument("--frames", type=int, default=100, help="frames per run")
