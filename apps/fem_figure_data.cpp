@@ -1,5 +1,5 @@
 // fem_figure_data: the code's own data behind the figures a table cannot show, as JSON for
-// scripts/figures.py (docs/data/figures/): chapter 10's hierarchy (level sizes and the
+// fem-tools plots figures (docs/data/figures/): chapter 10's hierarchy (level sizes and the
 // aggregate of every node) and chapter 11's node orders. The figures read the mesh file
 // themselves; the tet checksum lets them check that they number its nodes as load_mesh does.
 #include <iostream>

@@ -65,7 +65,7 @@ std::string command_line(int argc, char** argv) {
   return out;
 }
 
-// The table as committed data (docs/data/lessons/NAME.json): scripts/lesson_tables.py writes
+// The table as committed data (docs/data/lessons/NAME.json): fem-tools docs lessons writes
 // it between the lesson's markers of the chapter's README (or the lesson's own page), and
 // checks that it is there. A lesson's numbers, when it leaves them, go in "data".
 void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo* chapter,

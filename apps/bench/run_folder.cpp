@@ -67,7 +67,7 @@ void point_latest_at(const std::string& folder) {
 }
 
 int remove_previous_plots(const std::string& json) {
-  // The plots scripts/plot_results.py makes of a run.
+  // The plots fem-tools plots bench makes of a run.
   constexpr std::array<const char*, 5> kRunPlots = {
       "phases.png", "phases_stacked.png", "speedup.png", "allocations.png", "solvers.png"};
   int removed = 0;

@@ -1,5 +1,5 @@
 // A run is a folder: its bench.json and the plots ./tutorial.sh bench makes of it
-// (scripts/plot_results.py). The housekeeping around the JSON file.
+// (fem-tools plots bench). The housekeeping around the JSON file.
 #pragma once
 
 #include <optional>

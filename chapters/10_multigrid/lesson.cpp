@@ -6,7 +6,7 @@
 //    of prepare() and of one V-cycle in SpMV-equivalents, and PCG from a zero guess with the
 //    V-cycle, with chapter 09's block Jacobi and with Eigen's IncompleteCholesky CG;
 //  - with --export DIR: that system as Matrix Market (A.mtx, b.mtx, the filtered rigid-body
-//    modes B.mtx) and summary.json, for scripts/pyamg_reference.py.
+//    modes B.mtx) and summary.json, for fem-tools runs pyamg.
 // The report goes to stderr, the table (for --readme) to stdout.
 #include "chapters/10_multigrid/lesson.hpp"
 
@@ -209,7 +209,7 @@ FromZero from_zero(MultigridStepper& stepper, const Scene& scene, const SolverSe
   return out;
 }
 
-// The last system as Matrix Market for scripts/pyamg_reference.py, and a summary.
+// The last system as Matrix Market for fem-tools runs pyamg, and a summary.
 void export_system(const LessonRun& run, const MultigridStepper& stepper, const FromZero& z,
                    const std::string& dir) {
   const Scene& scene = run.scene;

@@ -139,21 +139,21 @@ def viewer_cases(viewer, tmp):
 
 
 def plot_case(tmp):
-    """The Python writers go through one helper (scripts/results_common.py replacing): a plot
+    """The Python writers go through one helper (femtools.files.replacing): a plot
     whose write fails leaves the earlier one."""
     folder = tmp / "plots"
     folder.mkdir()
     (folder / "phases.png").write_bytes(b"the earlier plot")
-    plot = [sys.executable, ROOT / "scripts" / "plot_results.py", ROOT / "tests" / "fixtures" / "bench_fixture.json",
+    plot = [sys.executable, "-m", "femtools", "plots", "bench", ROOT / "tests" / "fixtures" / "bench_fixture.json",
             "--out", folder]
     p = run(*plot, env={"FEM_FAIL_WRITES": "phases.png"})
-    check("plot_results.py: a failed plot write exits non-zero, naming the path and the cause",
+    check("fem-tools plots bench: a failed plot write exits non-zero, naming the path and the cause",
           p.returncode == 1 and f"cannot write '{folder / 'phases.png'}': No space left" in p.stderr,
           p.stdout + p.stderr)
-    check("plot_results.py: ... the earlier plot intact, no temporary left",
+    check("fem-tools plots bench: ... the earlier plot intact, no temporary left",
           snapshot(folder) == {"phases.png": b"the earlier plot"}, sorted(snapshot(folder)))
     p = run(*plot)
-    check("plot_results.py: the plots written whole otherwise",
+    check("fem-tools plots bench: the plots written whole otherwise",
           p.returncode == 0 and (folder / "phases.png").read_bytes().startswith(b"\x89PNG")
           and not any(n.startswith(".") for n in snapshot(folder)), p.stdout + p.stderr)
 
