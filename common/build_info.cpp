@@ -72,13 +72,9 @@ SourceState source_state() {
   return s;
 }
 
-std::string source_state_json(const SourceState& s) {
-  std::string out = "\"commit\": " + json_string(s.commit) + ", \"uncommitted\": ";
-  if (!s.known) return out + "null";
-  out += "[";
-  for (std::size_t i = 0; i < s.uncommitted.size(); ++i)
-    out += (i ? ", " : "") + json_string(s.uncommitted[i]);
-  return out + "]";
+void add_source_state(Json& out, const SourceState& s) {
+  out["commit"] = s.commit;
+  out["uncommitted"] = s.known ? Json(s.uncommitted) : Json();
 }
 
 }  // namespace fem

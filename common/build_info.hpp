@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "common/json.hpp"
+
 namespace fem {
 
 struct BuildInfo {
@@ -30,8 +32,8 @@ struct SourceState {
   bool known = false;  // false outside a git checkout (no git, a tarball)
 };
 SourceState source_state();
-// The JSON fields "commit": ..., "uncommitted": [...] (null when unknown).
-std::string source_state_json(const SourceState& s);
+// Adds the fields "commit": ... and "uncommitted": [...] (null when unknown) to a JSON object.
+void add_source_state(Json& out, const SourceState& s);
 
 // Where the repository is (meshes are found relative to it when a path is relative).
 std::string source_dir();

@@ -85,12 +85,10 @@ std::string LoadMonitor::warning() const {
          " after); its times are not the code's alone, rerun on a quiet machine";
 }
 
-std::string LoadMonitor::json_fields() const {
-  std::ostringstream out;
-  out << "\"load_average\": [" << load_before_ << ", " << load_after_
-      << "], \"other_cpus\": " << (other_cpus_ < 0.0 ? std::string("null") : number(other_cpus_))
-      << ", \"busy\": " << (busy() ? "true" : "false");
-  return out.str();
+void LoadMonitor::add_json_fields(Json& machine) const {
+  machine["load_average"] = {load_before_, load_after_};
+  machine["other_cpus"] = other_cpus_ < 0.0 ? Json() : Json(other_cpus_);
+  machine["busy"] = busy();
 }
 
 double other_cpus_now(double seconds) {

@@ -7,6 +7,8 @@
 
 #include <string>
 
+#include "common/json.hpp"
+
 namespace fem {
 
 // The 1-minute load average (/proc/loadavg), -1 where unknown. It lags: a build that ended a
@@ -31,8 +33,9 @@ class LoadMonitor {
   bool busy() const;
   // One line for the user when busy(), else "".
   std::string warning() const;
-  // The JSON fields of machine: "load_average": [before, after], "other_cpus", "busy".
-  std::string json_fields() const;
+  // Adds the fields "load_average": [before, after], "other_cpus" (null where unknown) and
+  // "busy" to a JSON object (bench.json's "machine").
+  void add_json_fields(Json& machine) const;
 
   static constexpr double kBusyCores = 0.25;
 

@@ -1,5 +1,6 @@
 #include "common/machine_record.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -123,21 +124,6 @@ int cpus_in_list(const std::string& list) {
   return count;
 }
 
-void read_caches(MachineRecord& m) {
-  for (int i = 0;; ++i) {
-    const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(i) + "/";
-    const std::string level = read_line(dir + "level");
-    if (level.empty()) return;
-    CacheLevel c;
-    c.level = std::stoi(level);
-    c.type = read_line(dir + "type");
-    c.bytes = size_in_bytes(read_line(dir + "size"));
-    const std::string shared = read_line(dir + "shared_cpu_list");
-    c.shared_by = shared.empty() ? 1 : cpus_in_list(shared);
-    m.caches.push_back(c);
-  }
-}
-
 long long memory_bytes() {
   std::ifstream in("/proc/meminfo");
   std::string line;
@@ -146,30 +132,43 @@ long long memory_bytes() {
   return -1;
 }
 
-std::string json_list(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + json_string(items[i]);
-  return out + "]";
-}
-
-std::string caches_json(const std::vector<CacheLevel>& caches) {
-  std::ostringstream out;
-  out << "[";
-  for (std::size_t i = 0; i < caches.size(); ++i)
-    out << (i ? ", " : "") << "{\"level\": " << caches[i].level
-        << ", \"type\": " << json_string(caches[i].type) << ", \"bytes\": " << caches[i].bytes
-        << ", \"shared_by\": " << caches[i].shared_by << "}";
-  out << "]";
-  return out.str();
-}
-
 }  // namespace
+
+std::vector<CacheLevel> cpu_caches() {
+  std::vector<CacheLevel> caches;
+  try {
+    for (int i = 0;; ++i) {
+      const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(i) + "/";
+      const std::string level = read_line(dir + "level");
+      if (level.empty()) break;
+      CacheLevel c;
+      c.level = std::stoi(level);
+      c.type = read_line(dir + "type");
+      c.bytes = size_in_bytes(read_line(dir + "size"));
+      const std::string shared = read_line(dir + "shared_cpu_list");
+      c.shared_by = shared.empty() ? 1 : std::max(1, cpus_in_list(shared));
+      caches.push_back(c);
+    }
+  } catch (const std::exception&) {
+    // A kernel that words a field otherwise: the caches read so far stand.
+  }
+  return caches;
+}
+
+std::vector<CacheLevel> data_caches(const std::vector<CacheLevel>& caches) {
+  std::vector<CacheLevel> data;
+  for (const CacheLevel& c : caches)
+    if (c.type != "Instruction" && c.level > 0 && c.bytes > 0) data.push_back(c);
+  std::stable_sort(data.begin(), data.end(),
+                   [](const CacheLevel& a, const CacheLevel& b) { return a.level < b.level; });
+  return data;
+}
 
 MachineRecord machine_record() {
   MachineRecord m;
   try {
     read_cpuinfo(m);
-    read_caches(m);
+    m.caches = cpu_caches();
     m.memory_bytes = memory_bytes();
   } catch (const std::exception&) {
     // A kernel that words a field otherwise leaves it unknown; the record is a note, not input.
@@ -182,17 +181,30 @@ MachineRecord machine_record() {
   return m;
 }
 
+void add_machine_record(Json& machine, const MachineRecord& m) {
+  machine["vendor"] = m.vendor;
+  machine["family"] = m.family;
+  machine["model"] = m.model;
+  machine["model_name"] = m.model_name;
+  machine["isa_build"] = m.isa_build;
+  machine["isa_cpu"] = m.isa_cpu;
+  machine["features_build"] = m.features_build;
+  machine["features_cpu"] = m.features_cpu;
+  machine["cores"] = m.cores;
+  machine["hardware_threads"] = m.hardware_threads;
+  Json caches = Json::array();
+  for (const CacheLevel& c : m.caches)
+    caches.push_back({{"level", c.level}, {"type", c.type}, {"bytes", c.bytes},
+                      {"shared_by", c.shared_by}});
+  machine["caches"] = std::move(caches);
+  machine["memory_bytes"] = m.memory_bytes;
+}
+
 std::string machine_record_json(const MachineRecord& m) {
-  std::ostringstream out;
-  out << "\"vendor\": " << json_string(m.vendor) << ", \"family\": " << m.family
-      << ", \"model\": " << m.model << ", \"model_name\": " << json_string(m.model_name)
-      << ", \"isa_build\": " << json_string(m.isa_build)
-      << ", \"isa_cpu\": " << json_string(m.isa_cpu)
-      << ", \"features_build\": " << json_list(m.features_build)
-      << ", \"features_cpu\": " << json_list(m.features_cpu) << ", \"cores\": " << m.cores
-      << ", \"hardware_threads\": " << m.hardware_threads
-      << ", \"caches\": " << caches_json(m.caches) << ", \"memory_bytes\": " << m.memory_bytes;
-  return out.str();
+  Json fields = Json::object();
+  add_machine_record(fields, m);
+  const std::string text = fields.dump(-1, ' ', false, Json::error_handler_t::replace);
+  return text.substr(1, text.size() - 2);  // without the braces
 }
 
 std::string machine_summary(const MachineRecord& m) {

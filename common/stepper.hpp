@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <array>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -46,7 +47,35 @@ struct StepProfile {
     relative_residual = solve.relative_residual;
     converged = solve.converged;
   }
+
+  // The phases above, in the poster's order, each with its name in the results
+  // (bench.json's "phases", its per-phase tables): the one list the bench, the roofline and
+  // the viewer iterate, so a phase added here reaches all of them. The last, "step", is the
+  // whole step.
+  struct Phase {
+    const char* name;
+    PhaseCost StepProfile::*cost;
+  };
+  static constexpr std::size_t kPhaseCount = 6;
+  static const std::array<Phase, kPhaseCount>& phases();
+  // f(name, cost) for each phase in order, on this profile's costs.
+  template <class F>
+  void for_each_phase(F&& f) const {
+    for (const Phase& p : phases()) f(p.name, this->*p.cost);
+  }
 };
+
+inline const std::array<StepProfile::Phase, StepProfile::kPhaseCount>& StepProfile::phases() {
+  static constexpr std::array<Phase, kPhaseCount> table = {{
+      {"forces", &StepProfile::forces},
+      {"dfdx", &StepProfile::dfdx},
+      {"compose", &StepProfile::compose},
+      {"constraints", &StepProfile::constraints},
+      {"solve", &StepProfile::solve},
+      {"step", &StepProfile::step},
+  }};
+  return table;
+}
 
 // Conjugate gradient settings, the same for every chapter so that timings compare.
 // Eigen's default tolerance is machine epsilon: always set it explicitly.

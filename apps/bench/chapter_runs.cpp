@@ -13,30 +13,26 @@ namespace fem::bench {
 
 namespace {
 
-std::array<PhaseCost, 6> phases(const StepProfile& p) {
-  return {p.forces, p.dfdx, p.compose, p.constraints, p.solve, p.step};
-}
-
 // One chapter's stepper, state and samples while the benchmark runs.
-struct ChapterRun {
+struct RunningChapter {
   int threads = 1;
   std::unique_ptr<Stepper> stepper;
   State state;
-  std::array<std::vector<double>, 6> ms;
+  std::array<std::vector<double>, StepProfile::kPhaseCount> ms;
   std::vector<double> allocations, iterations;
   ChapterResult result;
 };
 
 // A run per chapter, and per thread count for a chapter that uses threads ("09_threads@2").
-std::vector<ChapterRun> make_runs(const std::vector<const ChapterInfo*>& chapters,
+std::vector<RunningChapter> make_runs(const std::vector<const ChapterInfo*>& chapters,
                                   const Scene& scene, const SolverSettings& solver,
                                   const std::vector<int>& thread_counts) {
-  std::vector<ChapterRun> runs;
+  std::vector<RunningChapter> runs;
   for (const ChapterInfo* c : chapters) {
     std::unique_ptr<Stepper> first = c->make(scene, solver);
     const bool threaded = first->uses_threads();
     for (const int threads : threaded ? thread_counts : std::vector<int>{1}) {
-      ChapterRun run;
+      RunningChapter run;
       run.threads = threads;
       run.stepper = first ? std::move(first) : c->make(scene, solver);
       run.state = rest_state(scene);
@@ -52,7 +48,7 @@ std::vector<ChapterRun> make_runs(const std::vector<const ChapterInfo*>& chapter
 }
 
 // Step k of one run; its profile becomes samples when the step is a measured one.
-void step(ChapterRun& run, int k, bool measured) {
+void step(RunningChapter& run, int k, bool measured) {
   set_threads(run.threads);  // the next parallel region's team; no cost between steps
   alloc::Scope counter;
   run.stepper->step(run.state);
@@ -63,11 +59,11 @@ void step(ChapterRun& run, int k, bool measured) {
   if (!measured) return;
   ChapterResult& r = run.result;
   const StepProfile& p = run.stepper->profile();
-  const auto s = phases(p);
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    run.ms[i].push_back(1e3 * s[i].seconds);
-    r.phase_allocations[i] = s[i].allocations;  // deterministic: the last step's
-  }
+  std::size_t i = 0;
+  p.for_each_phase([&](const char*, const PhaseCost& cost) {
+    run.ms[i].push_back(1e3 * cost.seconds);
+    r.phase_allocations[i++] = cost.allocations;  // deterministic: the last step's
+  });
   run.allocations.push_back(static_cast<double>(allocs));
   r.allocations_max = std::max(r.allocations_max, allocs);
   run.iterations.push_back(p.cg_iterations);
@@ -75,7 +71,7 @@ void step(ChapterRun& run, int k, bool measured) {
   r.not_converged_steps += p.converged ? 0 : 1;
 }
 
-ChapterResult summary(const ChapterRun& run) {
+ChapterResult summary(const RunningChapter& run) {
   ChapterResult r = run.result;
   for (std::size_t i = 0; i < run.ms.size(); ++i) r.ms[i] = spread(run.ms[i]);
   r.allocations_per_step = median(run.allocations);
@@ -92,10 +88,10 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                                         const Scene& scene, const SolverSettings& solver,
                                         const std::vector<int>& thread_counts,
                                         const Schedule& schedule) {
-  std::vector<ChapterRun> runs = make_runs(chapters, scene, solver, thread_counts);
+  std::vector<RunningChapter> runs = make_runs(chapters, scene, solver, thread_counts);
   for (int k = 0; k < schedule.total(); ++k) {
     const auto start = std::chrono::steady_clock::now();
-    for (ChapterRun& run : runs) step(run, k, schedule.measured(k));
+    for (RunningChapter& run : runs) step(run, k, schedule.measured(k));
     // The first round allocates the steppers' buffers: the estimate is taken from the second.
     if (k == 1)
       announce_long_run(
@@ -107,7 +103,7 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                 << std::flush;
   }
   std::vector<ChapterResult> results;
-  for (const ChapterRun& run : runs) results.push_back(summary(run));
+  for (const RunningChapter& run : runs) results.push_back(summary(run));
   return results;
 }
 

@@ -12,17 +12,14 @@
 
 namespace fem::bench {
 
-constexpr std::array<const char*, 6> kPhases = {"forces",      "dfdx",  "compose",
-                                                "constraints", "solve", "step"};
-
 struct ChapterResult {
   std::string chapter;  // "09_threads@2": a chapter that uses threads, with its thread count
   std::string title;
   std::string variant_of;                        // a student's variant: its original
   std::string source_hash;                       // the chapter folder's sources, at build time
-  std::array<Spread, 6> ms{};                    // per phase, milliseconds
+  std::array<Spread, StepProfile::kPhaseCount> ms{};  // per phase (StepProfile::phases()), ms
   double allocations_per_step = 0.0;             // median over the measured steps
-  std::array<long long, 6> phase_allocations{};  // per phase, the last measured step
+  std::array<long long, StepProfile::kPhaseCount> phase_allocations{};  // the last step's
   long long allocations_max = 0;
   double cg_iterations = 0.0;      // median
   double relative_residual = 0.0;  // last step

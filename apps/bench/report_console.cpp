@@ -64,7 +64,7 @@ void print_chapters(const std::vector<ChapterResult>& results) {
                "chapter 07; chapter 08's fused element pass, which also fills A and b, so its dfdx "
                "is 0)\n";
   std::cout << std::left << std::setw(26) << "chapter" << std::right;
-  for (const char* p : kPhases) std::cout << std::setw(12) << p;
+  for (const StepProfile::Phase& p : StepProfile::phases()) std::cout << std::setw(12) << p.name;
   std::cout << std::setw(13) << "allocs/step" << std::setw(8) << "CG it" << std::setw(11)
             << "rel.res.\n";
   for (const auto& r : results) {

@@ -28,12 +28,10 @@ void phase_bars(const Session& session) {
   const StepProfile mean = session.mean_profile();
   const double step_ms = 1e3 * mean.step.seconds;
   ImGui::Text("Step %.2f ms (mean of the last %zu steps)", step_ms, session.history().size());
-  const std::pair<const char*, double> phases[] = {
-      {"forces", mean.forces.seconds},   {"df/dx", mean.dfdx.seconds},
-      {"compose", mean.compose.seconds}, {"constraints", mean.constraints.seconds},
-      {"solve", mean.solve.seconds},
-  };
-  for (const auto& [name, seconds] : phases) {
+  for (const StepProfile::Phase& phase : StepProfile::phases()) {
+    if (phase.cost == &StepProfile::step) continue;  // the whole, drawn as the step time
+    const char* name = phase.name;
+    const double seconds = (mean.*phase.cost).seconds;
     char label[32];
     std::snprintf(label, sizeof label, "%.3f ms", 1e3 * seconds);
     const float fraction =

@@ -134,12 +134,8 @@ StepProfile Session::mean_profile() const {
   const double n = static_cast<double>(history_.size());
   double iterations = 0.0;
   for (const StepProfile& p : history_) {
-    mean.forces.seconds += p.forces.seconds / n;
-    mean.dfdx.seconds += p.dfdx.seconds / n;
-    mean.compose.seconds += p.compose.seconds / n;
-    mean.constraints.seconds += p.constraints.seconds / n;
-    mean.solve.seconds += p.solve.seconds / n;
-    mean.step.seconds += p.step.seconds / n;
+    for (const StepProfile::Phase& phase : StepProfile::phases())
+      (mean.*phase.cost).seconds += (p.*phase.cost).seconds / n;
     iterations += p.cg_iterations / n;
     mean.converged = mean.converged && p.converged;
   }
