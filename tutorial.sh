@@ -152,7 +152,6 @@ install_system_packages() {
   [ "${FEM_SKIP_PACKAGES:-0}" = 1 ] && return 0
   command -v apt-get >/dev/null && command -v dpkg-query >/dev/null || refuse_without_apt
   local missing
-  command -v dpkg-query >/dev/null || return 0  # not Debian: the user installs them (README)
   missing=$(missing_packages "$@" | tr '\n' ' ')
   [ -z "${missing// /}" ] && return 0
   if [ "$(id -u)" -eq 0 ]; then
@@ -388,32 +387,13 @@ regimes() {
 lessons() {
   quiet_build
   log "lesson tables (fem_lessons, fem-tools runs pyamg: a few minutes), recorded in docs/data/lessons/"
-  mkdir -p docs/data/lessons
-  local lesson
-  for lesson in noalias dfdx-fill compose spmv rotations threads-element; do
-    "$BUILD_DIR/fem_lessons" "$lesson" --json "docs/data/lessons/$lesson.json" >/dev/null
-  done
-  "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --cost-threads 1,2 --json docs/data/lessons/multigrid.json >/dev/null
-  # Chapter 11: gmsh's own orders beside the chapter's, on the plate, beam_10k and (when
-  # `./tutorial.sh meshes --large` made it) the 82k-node beam.
+  # Chapter 11's table sets gmsh's own orders beside the chapter's: the meshes they number first.
   fem_tools runs renumber-meshes >/dev/null
-  local large=""
-  [ -f meshes/generated/beam_100k.msh ] && large=",meshes/generated/beam_100k.msh"
-  "$BUILD_DIR/fem_lessons" node-order --steps 10 --meshes "meshes/beam_10k.msh$large" \
-    --json docs/data/lessons/node-order.json >/dev/null
-  # Chapter 12: the V-cycle in double, in float, and float numbers in double arithmetic.
-  "$BUILD_DIR/fem_lessons" half-the-bytes --steps 10 --meshes "meshes/beam_10k.msh$large" \
-    --json docs/data/lessons/half-the-bytes.json >/dev/null
-  "$BUILD_DIR/fem_lessons" batched-elements --steps 20 --meshes "meshes/beam_10k.msh$large" \
-    --json docs/data/lessons/batched-elements.json >/dev/null
+  # Every lesson with the arguments it carries (Lesson::record_args; the 82k-node beam too when
+  # `./tutorial.sh meshes --large` made it).
+  "$BUILD_DIR/fem_lessons" record-all --out docs/data/lessons >/dev/null
   fem_tools runs pyamg --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
-  # The course's closing page: the roofs and every chapter on the plate, the last chapter on
-  # the 82k-node beam too when it was generated (docs/roofline.md, docs/images/roofline.png).
-  local beam=""
-  [ -f meshes/generated/beam_100k.msh ] && beam="meshes/generated/beam_100k.msh"
-  "$BUILD_DIR/fem_lessons" roofline --steps 20 --meshes "$beam" \
-    --json docs/data/lessons/roofline.json >/dev/null
   fem_tools plots roofline docs/data/lessons/roofline.json --out docs/images/roofline.png
   fem_tools docs lessons
   # The code's own data behind the figures of chapters 10 and 11 (fem-tools plots figures draws them).

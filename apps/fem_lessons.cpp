@@ -47,7 +47,9 @@ std::string usage() {
            std::string(std::max<int>(1, 17 - int(f.lesson.name.size())), ' ') +
            (f.chapter ? "chapter " + f.chapter->id.substr(0, 2) : std::string("the course")) +
            ": " + f.lesson.summary + "\n";
-  return out + "without a lesson: every lesson in turn, with its defaults\n";
+  return out + "without a lesson: every lesson in turn, with its defaults\n" +
+         "record-all [--out DIR]: every lesson with the arguments it is recorded with, as " +
+         "DIR/LESSON.json\n";
 }
 
 // The lesson `name` of chapter `id` (a variant has its own copy); throws UsageError.
@@ -70,18 +72,19 @@ std::string command_line(int argc, char** argv) {
 // checks that it is there. A lesson's numbers, when it leaves them, go in "data".
 void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo* chapter,
                 const std::string& command, const std::string& table, const std::string& data) {
-  std::ostringstream out;
   const std::string id = chapter ? chapter->id : "";
-  const std::string readme =
-      !lesson.readme.empty() ? lesson.readme : "chapters/" + id + "/README.md";
-  out << "{\n  \"schema_version\": 1,\n  \"lesson\": " << json_string(lesson.name)
-      << ",\n  \"chapter\": " << json_string(id) << ",\n  \"readme\": " << json_string(readme)
-      << ",\n  \"marker\": " << json_string(lesson.name + "-table")
-      << ",\n  \"command\": " << json_string(command) << ",\n  \"table\": " << json_string(table)
-      << ",\n  \"machine\": {" << machine_record_json(machine_record()) << "}";
-  if (!data.empty()) out << ",\n  \"data\": " << data;
-  out << "\n}\n";
-  write_file_atomically(path, out.str());
+  Json out = {{"schema_version", 1},
+              {"lesson", lesson.name},
+              {"chapter", id},
+              {"readme", !lesson.readme.empty() ? lesson.readme : "chapters/" + id + "/README.md"},
+              {"marker", lesson.name + "-table"},
+              {"command", command},
+              {"table", table}};
+  Json machine = Json::object();
+  add_machine_record(machine, machine_record());
+  out["machine"] = std::move(machine);
+  if (!data.empty()) out["data"] = Json::parse(data);
+  write_json_file(path, out);
 }
 
 // Fails before the work when the JSON cannot be written there.
@@ -165,6 +168,49 @@ int run_lesson(const Found& found, int argc, char** argv) {
   });
 }
 
+// The command line a lesson is recorded with: its record_args, its further meshes that exist
+// added to --meshes, and --json DIR/NAME.json.
+std::vector<std::string> recording_args(const Lesson& lesson, const std::string& dir) {
+  std::vector<std::string> words = {lesson.name};
+  words.insert(words.end(), lesson.record_args.begin(), lesson.record_args.end());
+  for (const std::string& mesh : lesson.record_meshes_if_present) {
+    if (!std::filesystem::exists(resolve_mesh_path(mesh))) continue;
+    const auto meshes = std::find(words.begin(), words.end(), "--meshes");
+    if (meshes == words.end() || meshes + 1 == words.end())
+      words.insert(words.end(), {"--meshes", mesh});
+    else
+      *(meshes + 1) += "," + mesh;
+  }
+  words.insert(words.end(),
+               {"--json", (std::filesystem::path(dir) / (lesson.name + ".json")).string()});
+  return words;
+}
+
+// fem_lessons record-all: every lesson of the course, each as recording_args() says, so that
+// no list of lessons and their arguments is kept anywhere else (./tutorial.sh lessons).
+int record_all(const std::vector<Found>& lessons, int argc, char** argv) {
+  const std::string program = "fem_lessons record-all";
+  ArgParser args(program,
+                 "Records every lesson's table with the arguments the lesson gives "
+                 "(Lesson::record_args), as DIR/LESSON.json.");
+  args.option("out", "DIR", "directory of the records (made if missing)", "docs/data/lessons");
+  return run_program(program, [&] {
+    if (!args.parse(argc, argv)) return 0;
+    const std::string dir = args.get("out");
+    std::filesystem::create_directories(dir);
+    for (const Found& found : lessons) {
+      std::vector<std::string> words = recording_args(found.lesson, dir);
+      std::vector<char*> lesson_argv;
+      for (std::string& w : words) lesson_argv.push_back(w.data());
+      progress("recording " + found.lesson.name + " (" + std::to_string(&found - &lessons[0] + 1) +
+               " of " + std::to_string(lessons.size()) + ")");
+      if (const int status = run_lesson(found, int(lesson_argv.size()), lesson_argv.data()))
+        return status;
+    }
+    return 0;
+  });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -182,6 +228,7 @@ int main(int argc, char** argv) {
     std::cout << usage() << "(fem_lessons LESSON --help for the options)\n";
     return 0;
   }
+  if (first == "record-all") return record_all(lessons, argc - 1, argv + 1);
   const auto it = std::find_if(lessons.begin(), lessons.end(),
                                [&](const Found& f) { return f.lesson.name == first; });
   if (it == lessons.end()) {

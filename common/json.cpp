@@ -1,11 +1,11 @@
 #include "common/json.hpp"
 
-#include "common/atomic_file.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+
+#include "common/atomic_file.hpp"
 
 namespace fem {
 
@@ -23,7 +23,8 @@ std::string plain(const Json& v) {
 }
 
 void write(std::string& out, const Json& v, int depth) {
-  const bool flat = std::none_of(v.begin(), v.end(), [](const Json& e) { return e.is_structured(); });
+  const bool flat =
+      std::none_of(v.begin(), v.end(), [](const Json& e) { return e.is_structured(); });
   if (!v.is_structured() || v.empty() || flat) {
     if (!v.is_structured()) {
       out += plain(v);

@@ -41,6 +41,11 @@ struct Lesson {
   // Where the table goes (between its markers): empty for its chapter's README; a lesson of
   // the whole course (the roofline) names its page.
   std::string readme = "";
+  // How `fem_lessons record-all` records the table (docs/data/lessons/NAME.json): its options
+  // beyond the defaults, and meshes added to its --meshes where they exist (the large ones
+  // `./tutorial.sh meshes --large` generates, which a fresh clone lacks).
+  std::vector<std::string> record_args = {};
+  std::vector<std::string> record_meshes_if_present = {};
 };
 
 // ---- what the measurements share ----------------------------------------------------------

@@ -194,8 +194,8 @@ void add_machine_record(Json& machine, const MachineRecord& m) {
   machine["hardware_threads"] = m.hardware_threads;
   Json caches = Json::array();
   for (const CacheLevel& c : m.caches)
-    caches.push_back({{"level", c.level}, {"type", c.type}, {"bytes", c.bytes},
-                      {"shared_by", c.shared_by}});
+    caches.push_back(
+        {{"level", c.level}, {"type", c.type}, {"bytes", c.bytes}, {"shared_by", c.shared_by}});
   machine["caches"] = std::move(caches);
   machine["memory_bytes"] = m.memory_bytes;
 }

@@ -25,8 +25,8 @@ struct RunningChapter {
 
 // A run per chapter, and per thread count for a chapter that uses threads ("09_threads@2").
 std::vector<RunningChapter> make_runs(const std::vector<const ChapterInfo*>& chapters,
-                                  const Scene& scene, const SolverSettings& solver,
-                                  const std::vector<int>& thread_counts) {
+                                      const Scene& scene, const SolverSettings& solver,
+                                      const std::vector<int>& thread_counts) {
   std::vector<RunningChapter> runs;
   for (const ChapterInfo* c : chapters) {
     std::unique_ptr<Stepper> first = c->make(scene, solver);

@@ -15,10 +15,10 @@ namespace fem::bench {
 struct ChapterResult {
   std::string chapter;  // "09_threads@2": a chapter that uses threads, with its thread count
   std::string title;
-  std::string variant_of;                        // a student's variant: its original
-  std::string source_hash;                       // the chapter folder's sources, at build time
+  std::string variant_of;                             // a student's variant: its original
+  std::string source_hash;                            // the chapter folder's sources, at build time
   std::array<Spread, StepProfile::kPhaseCount> ms{};  // per phase (StepProfile::phases()), ms
-  double allocations_per_step = 0.0;             // median over the measured steps
+  double allocations_per_step = 0.0;                  // median over the measured steps
   std::array<long long, StepProfile::kPhaseCount> phase_allocations{};  // the last step's
   long long allocations_max = 0;
   double cg_iterations = 0.0;      // median

@@ -41,8 +41,10 @@ void add_run(Json& out, const Scene& scene, const BenchOptions& options, const L
                      {"beta", scene.damping.beta}};
   out["cg_tolerance"] = options.solver.tolerance;
   out["cg_max_iterations"] = options.solver.max_iterations;
-  out["build"] = {
-      {"compiler", b.compiler}, {"flags", b.flags}, {"build_type", b.build_type}, {"eigen", b.eigen}};
+  out["build"] = {{"compiler", b.compiler},
+                  {"flags", b.flags},
+                  {"build_type", b.build_type},
+                  {"eigen", b.eigen}};
   Json machine = {{"cpu", cpu_model()}, {"threads", hardware_threads()}};
   load.add_json_fields(machine);
   add_machine_record(machine, machine_record());
@@ -71,9 +73,12 @@ Json chapter_json(const ChapterResult& r) {
 }
 
 Json solver_json(const SolverResult& s) {
-  return {{"name", s.name},         {"median_ms", s.median_ms},
-          {"setup_ms", s.setup_ms}, {"solve_ms", s.solve_ms},
-          {"iterations", s.iterations}, {"allocations_per_solve", s.allocations_per_solve}};
+  return {{"name", s.name},
+          {"median_ms", s.median_ms},
+          {"setup_ms", s.setup_ms},
+          {"solve_ms", s.solve_ms},
+          {"iterations", s.iterations},
+          {"allocations_per_solve", s.allocations_per_solve}};
 }
 
 }  // namespace

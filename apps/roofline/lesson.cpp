@@ -103,6 +103,8 @@ std::vector<Lesson> lessons() {
                   [](const LessonRun& run) { return roofline_table(run); },
                   true};
   roofline.readme = "docs/roofline.md";
+  roofline.record_args = {"--steps", "20"};
+  roofline.record_meshes_if_present = {"meshes/generated/beam_100k.msh"};
   return {roofline};
 }
 

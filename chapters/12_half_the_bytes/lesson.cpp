@@ -232,7 +232,7 @@ void add_options(ArgParser& args) {
 }  // namespace
 
 std::vector<Lesson> lessons() {
-  return {
+  std::vector<Lesson> all = {
       {"half-the-bytes",
        "the V-cycle in double, in float, and float numbers in double arithmetic: bytes, time, "
        "iterations",
@@ -242,6 +242,10 @@ std::vector<Lesson> lessons() {
        "the element terms one at a time (chapter 08) and a batch per vector register (chapter 12)",
        "meshes/plate_poster.msh", add_element_options,
        [](const LessonRun& run) { return batched_elements_table(run); }, false}};
+  all[0].record_args = {"--steps", "10", "--meshes", "meshes/beam_10k.msh"};
+  all[1].record_args = {"--steps", "20", "--meshes", "meshes/beam_10k.msh"};
+  for (Lesson& l : all) l.record_meshes_if_present = {"meshes/generated/beam_100k.msh"};
+  return all;
 }
 
 }  // namespace fem::ch12
