@@ -56,6 +56,22 @@ const ChapterInfo& find_chapter(const std::string& name) {
   throw std::invalid_argument("unknown chapter '" + name + "' (known: " + known + ")");
 }
 
+std::vector<const ChapterInfo*> find_chapters(const std::vector<std::string>& names) {
+  std::vector<const ChapterInfo*> out;
+  if (names.size() == 1 && names[0] == "all") {
+    for (const ChapterInfo& c : chapters()) out.push_back(&c);
+    return out;
+  }
+  for (const std::string& name : names) {
+    const ChapterInfo* found = &find_chapter(name);
+    if (std::find(out.begin(), out.end(), found) != out.end())
+      throw std::invalid_argument("the chapter " + found->id + " is named twice");
+    out.push_back(found);
+  }
+  if (out.empty()) throw std::invalid_argument("no chapter named");
+  return out;
+}
+
 std::unique_ptr<Stepper> make_stepper(const std::string& chapter, const Scene& scene,
                                       const SolverSettings& settings) {
   return find_chapter(chapter).make(scene, settings);

@@ -37,6 +37,12 @@ const ChapterInfo& latest_chapter();
 // throws std::invalid_argument listing the known chapters otherwise.
 const ChapterInfo& find_chapter(const std::string& name);
 
+// A list of chapters as the programs take it (--chapters): names as find_chapter takes them,
+// or the single word "all", which means every chapter present, each student's variant
+// included, in course order. Throws std::invalid_argument for an unknown name, a chapter
+// named twice (it would be two rows of one name in every table) or an empty list.
+std::vector<const ChapterInfo*> find_chapters(const std::vector<std::string>& names);
+
 std::unique_ptr<Stepper> make_stepper(const std::string& chapter, const Scene& scene,
                                       const SolverSettings& settings = {});
 

@@ -1,5 +1,6 @@
 #include "common/cli.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -113,6 +114,26 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
+std::vector<std::string> ArgParser::get_list(const std::string& name) const {
+  std::vector<std::string> items;
+  std::stringstream list(get(name));
+  for (std::string item; std::getline(list, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+std::vector<int> ArgParser::get_int_list(const std::string& name) const {
+  std::vector<int> out;
+  for (const std::string& item : get_list(name)) {
+    const std::optional<int> v = parse_int(item);
+    if (!v)
+      throw UsageError("--" + name + " expects integers separated by commas, got '" + get(name) +
+                       "'");
+    if (std::find(out.begin(), out.end(), *v) == out.end()) out.push_back(*v);
+  }
+  return out;
+}
+
 std::string ArgParser::help() const {
   std::ostringstream out;
   out << "usage: " << program_ << " [options]\n\n" << summary_ << "\n\noptions:\n";
@@ -208,13 +229,21 @@ void add_thread_option(ArgParser& args) {
               "");
 }
 
-void apply_thread_environment() {
-  try {
-    if (const std::string warning = check_thread_environment(); !warning.empty())
-      std::cerr << "warning: " << warning << "\n";
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
+std::vector<int> thread_counts_from_args(const ArgParser& args, const std::string& name) {
+  std::vector<int> counts = args.get_int_list(name);
+  if (counts.empty()) {
+    apply_thread_environment();  // OMP_NUM_THREADS, held to the rule of --threads
+    counts = max_threads() > 1 ? std::vector<int>{1, max_threads()} : std::vector<int>{1};
   }
+  for (const int n : counts) {
+    try {
+      if (const std::string warning = check_thread_count(n); !warning.empty())
+        std::cerr << "warning: --" << name << " " << n << ": " << warning << "\n";
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--" + name + " " + std::to_string(n) + ": " + e.what());
+    }
+  }
+  return counts;
 }
 
 int threads_from_args(const ArgParser& args) {

@@ -37,6 +37,11 @@ class ArgParser {
   double get_double(const std::string& name) const;  // throws UsageError if not a number
   int get_int(const std::string& name) const;        // throws UsageError if not an integer
   bool has_flag(const std::string& name) const;
+  // The option's comma-separated items, empty ones skipped: "09,,12" -> {"09", "12"}; "" -> {}.
+  std::vector<std::string> get_list(const std::string& name) const;
+  // The items as integers, a repeated one kept once (at its first place); throws UsageError
+  // for an item that is not an integer.
+  std::vector<int> get_int_list(const std::string& name) const;
   std::string help() const;
 
  private:
@@ -75,6 +80,11 @@ void apply_thread_environment();
 // for a shorter one. Flushed, as every progress line is, so that it reaches a file as it
 // reaches a terminal.
 void announce_long_run(const std::string& program, double seconds_per_step, long long steps);
+
+// The thread counts of a list option (fem_bench --threads, fem_lessons multigrid
+// --cost-threads): each checked as --threads is (UsageError; a warning on stderr above the
+// hardware threads), a repeated one kept once; when the option is empty, 1 and OpenMP's count.
+std::vector<int> thread_counts_from_args(const ArgParser& args, const std::string& name);
 
 // main()'s error handling, written once: returns body()'s exit status; a UsageError prints
 // "<program>: <why> (see <program> --help)" and returns 2, any other exception

@@ -14,58 +14,6 @@ namespace fem::bench {
 
 namespace {
 
-// "1,2,4" -> {1, 2, 4}; empty -> 1 and OpenMP's count (OMP_NUM_THREADS or every core).
-std::vector<int> parse_thread_counts(const std::string& list) {
-  if (list.empty()) {
-    apply_thread_environment();
-    std::vector<int> out = {1};
-    if (max_threads() > 1) out.push_back(max_threads());
-    return out;
-  }
-  std::vector<int> out;
-  std::stringstream in(list);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    const std::optional<int> parsed = parse_int(item);
-    if (!parsed || *parsed < 1)
-      throw UsageError("--threads expects thread counts >= 1 separated by commas, got '" + list +
-                       "'");
-    const int n = *parsed;
-    try {
-      if (const std::string warning = check_thread_count(n); !warning.empty())
-        std::cerr << "fem_bench: warning: --threads " << item << ": " << warning << "\n";
-    } catch (const std::invalid_argument& e) {
-      throw UsageError("--threads " + item + ": " + e.what());
-    }
-    if (std::find(out.begin(), out.end(), n) == out.end()) out.push_back(n);
-  }
-  return out;
-}
-
-std::vector<const ChapterInfo*> parse_chapters(const std::string& list) {
-  std::vector<const ChapterInfo*> out;
-  if (list == "all") {
-    for (const auto& c : chapters()) out.push_back(&c);
-    return out;
-  }
-  std::stringstream in(list);
-  std::string name;
-  while (std::getline(in, name, ',')) {
-    const ChapterInfo* found = nullptr;
-    try {
-      found = &find_chapter(name);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
-    // Twice the same chapter would be two rows of one name in every table and plot.
-    if (std::find(out.begin(), out.end(), found) != out.end())
-      throw UsageError("--chapters names " + found->id + " twice");
-    out.push_back(found);
-  }
-  if (out.empty()) throw UsageError("--chapters is empty");
-  return out;
-}
-
 // Without --out, a new folder per run, results/run-YYYYMMDD-HHMMSS (a second run in the same
 // second gets -2, -3, ...): a run never replaces an earlier one unless asked (--replace).
 std::string new_run_folder() {
@@ -106,7 +54,8 @@ Schedule schedule(const ArgParser& args) {
 void add_bench_options(ArgParser& args) {
   add_scene_options(args, "meshes/plate_poster.msh");
   add_solver_options(args);
-  args.option("chapters", "LIST", "comma-separated chapters, or 'all'", "all");
+  args.option("chapters", "LIST",
+              "comma-separated chapters, or 'all' (every chapter, variants included)", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
   args.option("warmup", "N",
               "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)",
@@ -129,10 +78,14 @@ void add_bench_options(ArgParser& args) {
 
 BenchOptions bench_options(const ArgParser& args) {
   BenchOptions o;
-  o.chapters = parse_chapters(args.get("chapters"));
+  try {
+    o.chapters = find_chapters(args.get_list("chapters"));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--chapters: ") + e.what());
+  }
   o.schedule = schedule(args);
   o.solver = solver_from_args(args);
-  o.thread_counts = parse_thread_counts(args.get("threads"));
+  o.thread_counts = thread_counts_from_args(args, "threads");
   o.json = json_path(args);
   o.json_named = !args.get("json").empty();
   o.replace = args.has_flag("replace");

@@ -53,9 +53,22 @@ class ElementKernelsStepper : public Stepper {
   bool warned_not_converged_ = false;
 
   FusedElements elements_;
-  BlockSparseMatrix A_;         // M - h df/dv - h^2 df/dx, the mesh's block pattern
-  BlockIndex index_;            // where element, diagonal and transposed blocks sit in A_
-  Eigen::VectorXd b_;           // h (f + h df/dx v)
+
+  // The system A dv = b a step builds, for a later chapter's start_system or element_pass
+  // to write: the one way in, so that `grep system_to_write` finds every place that writes it.
+  BlockSparseMatrix& system_to_write() { return A_; }
+  Eigen::VectorXd& rhs_to_write() { return b_; }
+
+ private:
+  BlockSparseMatrix A_;  // M - h df/dv - h^2 df/dx, the mesh's block pattern
+
+ protected:
+  BlockIndex index_;  // where element, diagonal and transposed blocks sit in A_
+
+ private:
+  Eigen::VectorXd b_;  // h (f + h df/dx v)
+
+ protected:
   Eigen::VectorXd z_;           // prescribed velocity change of constrained dofs
   Eigen::VectorXd filtered_b_;  // S (b - A z)
   Eigen::VectorXd dv_;

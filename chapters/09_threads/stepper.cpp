@@ -84,8 +84,8 @@ ThreadsStepper::ThreadsStepper(const Scene& scene, const SolverSettings& setting
                                ElementParallelism element_parallelism)
     : ElementKernelsStepper(scene, settings),
       element_parallelism_(element_parallelism),
-      chunks_(A_),
-      parallel_pcg_(A_, scene.constraints),
+      chunks_(system_matrix()),
+      parallel_pcg_(system_matrix(), scene.constraints),
       block_jacobi_(index_.diagonal) {
   if (element_parallelism_ == ElementParallelism::gather)
     build_gather_tables();
@@ -124,7 +124,7 @@ void ThreadsStepper::build_gather_tables() {
       model_.num_nodes, 4 * num_elements, [this](int t) { return model_.tets[t / 4][t % 4]; },
       node_corner_start_, node_corners_);
   invert(
-      static_cast<int>(A_.blocks.size()), 16 * num_elements,
+      static_cast<int>(system_matrix().blocks.size()), 16 * num_elements,
       [this](int t) { return index_.element[t / 16][t % 16]; }, block_term_start_, block_terms_);
 }
 
@@ -151,26 +151,30 @@ void ThreadsStepper::start_system(const State& state) {
   // What the elements do not touch: A = (1 + h alpha) M, b = h (f_gravity - alpha M v + f_ext),
   // row by row on the thread that owns the row.
   const double mass_factor = 1.0 + h * alpha;
+  auto& A = system_to_write();
+  auto& b = rhs_to_write();
   run_parallel([&] {
     for (const int c : StaticShare(chunks_.count())) {
-      for (int k = A_.row_start[chunks_.start[c]]; k < A_.row_start[chunks_.start[c + 1]]; ++k)
-        A_.blocks[k].setZero();
+      for (int k = A.row_start[chunks_.start[c]]; k < A.row_start[chunks_.start[c + 1]]; ++k)
+        A.blocks[k].setZero();
       for (int i = chunks_.start[c]; i < chunks_.start[c + 1]; ++i)
-        A_.blocks[index_.diagonal[i]].diagonal() =
+        A.blocks[index_.diagonal[i]].diagonal() =
             mass_factor * model_.lumped_mass.segment<3>(3 * i);
       const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
-      b_.segment(first, size).noalias() =
+      b.segment(first, size).noalias() =
           h * model_.gravity_force.segment(first, size) -
           (h * alpha) *
               model_.lumped_mass.segment(first, size).cwiseProduct(state.v.segment(first, size));
     }
   });
-  b_ += h * f_ext_;  // a few nonzeros, added into a dense vector: not worth a thread
+  b += h * f_ext_;  // a few nonzeros, added into a dense vector: not worth a thread
 }
 
 void ThreadsStepper::element_pass_gather(const State& state) {
   const int num_elements = static_cast<int>(model_.tets.size());
   long long fallbacks = 0;
+  auto& A = system_to_write();
+  auto& b = rhs_to_write();
   run_parallel([&] {
     long long my_fallbacks = 0;  // this thread's: added to the total once, at the end
     // Every element on its own: its terms go to its own slots, nothing is shared.
@@ -180,13 +184,13 @@ void ThreadsStepper::element_pass_gather(const State& state) {
     // block over the element blocks that land on it.
     for (const int c : StaticShare(chunks_.count())) {
       for (int i = chunks_.start[c]; i < chunks_.start[c + 1]; ++i) {
-        Eigen::Vector3d sum = b_.segment<3>(3 * i);
+        Eigen::Vector3d sum = b.segment<3>(3 * i);
         for (int k = node_corner_start_[i]; k < node_corner_start_[i + 1]; ++k)
           sum += element_terms_[node_corners_[k] / 4].rhs.col(node_corners_[k] % 4);
-        b_.segment<3>(3 * i) = sum;
+        b.segment<3>(3 * i) = sum;
       }
-      for (int k = A_.row_start[chunks_.start[c]]; k < A_.row_start[chunks_.start[c + 1]]; ++k) {
-        Eigen::Matrix3d sum = A_.blocks[k];
+      for (int k = A.row_start[chunks_.start[c]]; k < A.row_start[chunks_.start[c + 1]]; ++k) {
+        Eigen::Matrix3d sum = A.blocks[k];
         for (int t = block_term_start_[k]; t < block_term_start_[k + 1]; ++t) {
           const PairOf from = kPairOf[block_terms_[t] % 16];
           const Eigen::Matrix3d& K = element_terms_[block_terms_[t] / 16].K[from.pair];
@@ -195,7 +199,7 @@ void ThreadsStepper::element_pass_gather(const State& state) {
           else
             sum += K;
         }
-        A_.blocks[k] = sum;
+        A.blocks[k] = sum;
       }
     }
     add_count(fallbacks, my_fallbacks);
@@ -204,18 +208,21 @@ void ThreadsStepper::element_pass_gather(const State& state) {
 }
 
 void ThreadsStepper::element_pass_colouring(const State& state) {
+  auto& A = system_to_write();
+  auto& b = rhs_to_write();
   elements_.end_pass(for_coloured_groups([&](int first, int last, long long& fallbacks) {
     ch08::ElementTerms terms;
     for (int e = first; e < last; ++e) {
       elements_.terms(e, model_.tets[e], state, fallbacks, terms);
-      ch08::scatter(model_.tets[e], index_.element[e], terms, A_, b_);
+      ch08::scatter(model_.tets[e], index_.element[e], terms, A, b);
     }
   }));
 }
 
 void ThreadsStepper::solve() {
   // Warm start: y_ still holds the previous step's answer; the solver filters it.
-  const SolveStats result = parallel_pcg_.solve(A_, *preconditioner_, filtered_b_, settings_, y_);
+  const SolveStats result =
+      parallel_pcg_.solve(system_matrix(), *preconditioner_, filtered_b_, settings_, y_);
   dv_ = y_;
   dv_ += z_;
   profile_.record(result);

@@ -23,6 +23,7 @@
 
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
+#include "chapters/10_multigrid/lesson_options.hpp"
 #include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "common/atomic_file.hpp"
@@ -236,7 +237,7 @@ void print_hierarchy(const Multigrid& mg, double setup_ms) {
             << " ms for the whole stepper)\n";
   long long blocks = 0, fine_blocks = 0;
   for (int l = 0; l < mg.levels(); ++l) {
-    const int block = l == 0 ? 3 : 6;
+    const int block = l == 0 ? 3 : kModes;  // a node's 3 dofs, then an aggregate's modes
     std::cerr << "  level " << l << ": " << std::setw(7) << level_dofs(mg, l) << " unknowns, "
               << std::setw(8) << level_blocks(mg, l) << " blocks of " << block << "x" << block
               << ", " << level_row_blocks(mg, l) << " row blocks";
@@ -282,7 +283,7 @@ std::string multigrid_table(const LessonRun& run) {
   const Scene& scene = run.scene;
   const SolverSettings solver = solver_from_args(args);
   const MultigridStepperSettings settings = multigrid_from_args(args);
-  const std::vector<int> counts = cost_thread_counts(args);
+  const std::vector<int> counts = thread_counts_from_args(args, "cost-threads");
   std::cerr << "fem_lessons multigrid: scene " << scene.name << ", mesh " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes), " << run.steps << " steps, tol "
             << solver.tolerance << ", smoother " << args.get("smoother") << ", " << max_threads()

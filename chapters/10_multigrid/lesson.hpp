@@ -13,10 +13,4 @@ namespace fem::ch10 {
 
 std::vector<Lesson> lessons();
 
-// The lesson's options (lesson_options.cpp): declared with the chapter's defaults, read back
-// as the stepper's settings, and the thread counts of the cost table.
-void add_multigrid_options(ArgParser& args);
-MultigridStepperSettings multigrid_from_args(const ArgParser& args);
-std::vector<int> cost_thread_counts(const ArgParser& args);
-
 }  // namespace fem::ch10

@@ -1,10 +1,11 @@
 // Chapter 10's lesson options: `fem_lessons multigrid`'s command line, its defaults the
 // chapter's (MultigridStepperSettings{}), and the settings it asks for (see lesson.hpp).
+#include "chapters/10_multigrid/lesson_options.hpp"
+
 #include <cstdlib>
 #include <sstream>
 #include <string>
 
-#include "chapters/10_multigrid/lesson.hpp"
 #include "common/threads.hpp"
 
 namespace fem::ch10 {
@@ -41,14 +42,11 @@ MultigridStepperSettings multigrid_from_args(const ArgParser& args) {
   r.sweeps = args.get_int("sweeps");
   r.l1 = args.get("l1") != "off";
   settings.extrapolation = args.get_int("extrapolate");
-  if (settings.extrapolation < 0 || settings.extrapolation > 2)
-    throw UsageError("--extrapolate must be 0, 1 or 2");
   s.rows.max_blocks = args.get_int("blocks");
   s.rows.serial_rows = args.get_int("serial-rows");
   r.chebyshev_degree = args.get_int("degree");
   c.improve_candidates = args.get_int("improve");
   c.power_iterations = args.get_int("power");
-  if (c.power_iterations < 1) throw UsageError("--power must be at least 1");
   const std::string prolongator = args.get("prolongator");
   if (prolongator != "every-step" && prolongator != "frozen" && prolongator != "tentative")
     throw UsageError("--prolongator must be frozen, every-step or tentative");
@@ -57,32 +55,13 @@ MultigridStepperSettings multigrid_from_args(const ArgParser& args) {
   s.max_coarse_dofs = args.get_int("max-coarse");
   s.refresh.every = args.get_int("coarse-every");
   s.refresh.growth = args.get_double("growth");
-  if (s.refresh.every < 1) throw UsageError("--coarse-every must be at least 1");
-  if (c.modes != 3 && c.modes != 6) throw UsageError("--modes must be 3 or 6");
-  if (r.sweeps < 1) throw UsageError("--sweeps must be at least 1");
-  if (s.max_coarse_dofs < 6) throw UsageError("--max-coarse must be at least 6");
-  if (s.rows.max_blocks < 1 || r.chebyshev_degree < 1 || c.improve_candidates < 0 ||
-      s.rows.serial_rows < 0)
-    throw UsageError(
-        "--blocks and --degree must be at least 1, --improve and --serial-rows 0 or more");
-  if (!(s.refresh.growth >= 0.0)) throw UsageError("--growth must be 0 (off) or more");
   if (args.get("l1") != "on" && args.get("l1") != "off") throw UsageError("--l1 must be on or off");
-  return settings;
-}
-
-std::vector<int> cost_thread_counts(const ArgParser& args) {
-  std::vector<int> out;
-  std::stringstream list(args.get("cost-threads"));
-  for (std::string item; std::getline(list, item, ',');) {
-    const int n = std::atoi(item.c_str());
-    if (n < 1 || std::to_string(n) != item)
-      throw UsageError("--cost-threads expects thread counts >= 1 separated by commas");
-    if (n > 1 && !openmp_enabled()) throw UsageError("--cost-threads: this build has no OpenMP");
-    out.push_back(n);
+  try {
+    check(settings);  // the stepper's own rule: one place says what is allowed
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
   }
-  if (out.empty()) out = {1, max_threads()};
-  if (out.size() == 2 && out[0] == out[1]) out.pop_back();
-  return out;
+  return settings;
 }
 
 // The options' defaults are the chapter's (MultigridStepperSettings{}).

@@ -24,22 +24,6 @@ namespace fem::ch10 {
 
 namespace {
 
-void check(const MultigridSettings& s) {
-  const CoarseningSettings& c = s.coarsening;
-  const SmootherSettings& r = s.relax;
-  if (c.modes != 3 && c.modes != kModes)
-    throw std::invalid_argument("multigrid: modes must be 3 or 6");
-  if (r.sweeps < 1 || s.max_levels < 1 || c.power_iterations < 1 || s.refresh.every < 1 ||
-      s.rows.max_blocks < 1 || s.rows.block_rows < 1 || r.chebyshev_degree < 1 ||
-      c.improve_candidates < 0)
-    throw std::invalid_argument(
-        "multigrid: sweeps, levels, power iterations, coarse refresh, blocks, block rows and "
-        "Chebyshev degree must be >= 1, candidate sweeps >= 0");
-  if (!(r.chebyshev_ratio > 1.0) || !(s.refresh.growth >= 0.0) || !(r.jacobi_weight >= 0.0))
-    throw std::invalid_argument(
-        "multigrid: the Chebyshev ratio must exceed 1, growth and Jacobi weight be >= 0");
-}
-
 // A level's tables and vectors, and the smoother it runs.
 template <int B>
 void set_up(Level<B>& level, const MultigridSettings& settings) {
@@ -73,6 +57,27 @@ const Aggregates<kModes>& aggregates_of(const Coarsening& c, const Level<kModes>
 }
 
 }  // namespace
+
+void check(const MultigridSettings& s) {
+  const CoarseningSettings& c = s.coarsening;
+  const SmootherSettings& r = s.relax;
+  if (c.modes != 3 && c.modes != kModes)
+    throw std::invalid_argument("multigrid: modes must be 3 or 6");
+  if (r.sweeps < 1 || s.max_levels < 1 || c.power_iterations < 1 || s.refresh.every < 1 ||
+      s.rows.max_blocks < 1 || s.rows.block_rows < 1 || r.chebyshev_degree < 1)
+    throw std::invalid_argument(
+        "multigrid: sweeps, levels, power iterations, the coarse refresh's period, blocks, block "
+        "rows and the Chebyshev degree must be at least 1");
+  if (c.improve_candidates < 0 || s.rows.serial_rows < 0)
+    throw std::invalid_argument("multigrid: candidate sweeps and serial rows must be 0 or more");
+  // The coarsest level is at least one aggregate's modes.
+  if (s.max_coarse_dofs < kModes)
+    throw std::invalid_argument("multigrid: the coarsest size (max coarse dofs) must be at least " +
+                                std::to_string(kModes));
+  if (!(r.chebyshev_ratio > 1.0) || !(s.refresh.growth >= 0.0) || !(r.jacobi_weight >= 0.0))
+    throw std::invalid_argument(
+        "multigrid: the Chebyshev ratio must exceed 1, growth and Jacobi weight be >= 0");
+}
 
 Multigrid::Multigrid(const MultigridSettings& settings)
     : settings_(settings), refresh_rule_(settings.refresh) {

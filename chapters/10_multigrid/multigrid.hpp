@@ -62,6 +62,11 @@ struct MultigridSettings {
   int max_coarse_dofs = 200;  // the dense Cholesky's size limit
 };
 
+// The settings' one check, run by the constructors (Multigrid's, the steppers' through
+// check(MultigridStepperSettings)); the lesson's command line turns it into a usage error.
+// Throws std::invalid_argument naming what is out of range.
+void check(const MultigridSettings& settings);
+
 struct Coarsening;  // the set-up data (coarsening.hpp)
 
 class Multigrid {

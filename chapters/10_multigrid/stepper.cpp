@@ -32,14 +32,18 @@ void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& 
   multigrid_.apply(r, s);
 }
 
+void check(const MultigridStepperSettings& settings) {
+  check(settings.multigrid);
+  if (settings.extrapolation < 0 || settings.extrapolation > 2)
+    throw std::invalid_argument("multigrid stepper: the guess's extrapolation order is 0, 1 or 2");
+}
+
 MultigridStepper::MultigridStepper(const Scene& scene, const SolverSettings& settings,
                                    const MultigridStepperSettings& multigrid,
                                    ch09::ElementParallelism element_parallelism)
     : ThreadsStepper(scene, settings, element_parallelism),
-      multigrid_(multigrid.multigrid),
+      multigrid_((check(multigrid), multigrid.multigrid)),
       extrapolation_(multigrid.extrapolation) {
-  if (extrapolation_ < 0 || extrapolation_ > 2)
-    throw std::invalid_argument("multigrid stepper: the guess's extrapolation order is 0, 1 or 2");
   // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
   multigrid_.analyze_pattern(system_matrix().row_start, system_matrix().column,
                              rest_positions(scene), scene.constraints);

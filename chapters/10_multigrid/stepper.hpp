@@ -21,6 +21,8 @@ struct MultigridStepperSettings {
   // + y_(n-2)).
   int extrapolation = 2;
 };
+// check(settings.multigrid) and the extrapolation's order; throws std::invalid_argument.
+void check(const MultigridStepperSettings& settings);
 
 // One V-cycle of the hierarchy as the preconditioner of chapter 09's PCG: prepare() gives
 // the hierarchy this solve's matrix (factorize), apply() runs one cycle from a zero guess.

@@ -86,7 +86,8 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
   const double mb = 1e-6 * static_cast<double>(bytes);
   std::ostringstream out;
   out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes), V-cycle"
-      << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at 1e-4";
+      << " | its numbers, MB | one V-cycle, ms | solve, ms | CG it. at "
+      << SolverSettings{}.tolerance;
   for (const double t : tight) out << " | CG it. at " << t;
   out << " |\n| --- | ---: | ---: | ---: | ---:";
   for (std::size_t t = 0; t < tight.size(); ++t) out << " | ---:";

@@ -32,13 +32,15 @@ void HalfBytesStepper::element_pass(const State& state) {
   // Chapter 09's colour loop; inside a group, kLanes consecutive elements at a time, each
   // batch's terms scattered in element order, so the sums (and the state) are the same for
   // any thread count.
+  auto& A = system_to_write();
+  auto& b = rhs_to_write();
   batched_.end_pass(for_coloured_groups([&](int first, int last, long long& fallbacks) {
     BatchTerms terms;  // on this thread's stack: no allocation, no sharing
     for (int e = first; e < last; e += kLanes) {
       const int count = std::min(kLanes, last - e);
       batched_.terms(e, count, model_.tets, state, fallbacks, terms);
       for (int l = 0; l < count; ++l)
-        scatter(terms, l, model_.tets[e + l], index_.element[e + l], A_, b_);
+        scatter(terms, l, model_.tets[e + l], index_.element[e + l], A, b);
     }
   }));
 }
