@@ -38,11 +38,21 @@ void check(const MultigridStepperSettings& settings) {
     throw std::invalid_argument("multigrid stepper: the guess's extrapolation order is 0, 1 or 2");
 }
 
+namespace {
+
+// The hierarchy's settings, once all of the stepper's are checked: the first member built.
+const MultigridSettings& checked(const MultigridStepperSettings& settings) {
+  check(settings);
+  return settings.multigrid;
+}
+
+}  // namespace
+
 MultigridStepper::MultigridStepper(const Scene& scene, const SolverSettings& settings,
                                    const MultigridStepperSettings& multigrid,
                                    ch09::ElementParallelism element_parallelism)
     : ThreadsStepper(scene, settings, element_parallelism),
-      multigrid_((check(multigrid), multigrid.multigrid)),
+      multigrid_(checked(multigrid)),
       extrapolation_(multigrid.extrapolation) {
   // The hierarchy's set-up: aggregates, rigid-body modes at the rest positions, patterns.
   multigrid_.analyze_pattern(system_matrix().row_start, system_matrix().column,
