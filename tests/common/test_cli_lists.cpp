@@ -38,7 +38,7 @@ TEST_CASE("a thread-count list is checked as --threads is, and empty means 1 and
   CHECK(defaults.back() == max_threads());
 }
 
-TEST_CASE("a chapter list: names, or 'all' for every chapter present; a repeat is refused") {
+TEST_CASE("a chapter list: names, or 'all' for every chapter present, and a repeat refused") {
   CHECK(find_chapters({"all"}).size() == chapters().size());
   const auto two = find_chapters({"12", "01"});
   REQUIRE(two.size() == 2);
