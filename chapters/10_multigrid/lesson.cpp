@@ -35,8 +35,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The filtered rigid-body modes at the rest positions, 3N x 6: PyAMG's B.
-Eigen::MatrixXd rigid_body_modes(const Scene& scene) {
+// The filtered rigid-body modes of the whole body, 3N x 6: PyAMG's B (rigid_body_modes in
+// near_null_space.hpp gives each aggregate's, about its own centroid).
+Eigen::MatrixXd whole_body_modes(const Scene& scene) {
   const int n = scene.mesh.num_nodes();
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(3 * n, 6);
   const Eigen::Vector3d c = scene.mesh.X.rowwise().mean();
@@ -218,7 +219,7 @@ void export_system(const LessonRun& run, const MultigridStepper& stepper, const 
   const Eigen::VectorXd& b = stepper.system_rhs();
   std::filesystem::create_directories(dir);
   if (!Eigen::saveMarket(csc, dir + "/A.mtx") || !Eigen::saveMarketVector(b, dir + "/b.mtx") ||
-      !Eigen::saveMarket(Eigen::SparseMatrix<double>(rigid_body_modes(scene).sparseView()),
+      !Eigen::saveMarket(Eigen::SparseMatrix<double>(whole_body_modes(scene).sparseView()),
                          dir + "/B.mtx"))
     throw std::runtime_error("cannot write Matrix Market files into '" + dir + "'");
   std::ostringstream summary;
