@@ -229,6 +229,15 @@ void add_thread_option(ArgParser& args) {
               "");
 }
 
+void apply_thread_environment() {
+  try {
+    if (const std::string warning = check_thread_environment(); !warning.empty())
+      std::cerr << "warning: " << warning << "\n";
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 std::vector<int> thread_counts_from_args(const ArgParser& args, const std::string& name) {
   std::vector<int> counts = args.get_int_list(name);
   if (counts.empty()) {
