@@ -2,11 +2,17 @@
 """The roofline plot of `fem_lessons roofline --json FILE` (its "data"): the machine's roofs
 (read bandwidth of each level of the memory hierarchy and the peak multiply-add rate, as
 measured) and one point per chapter and phase, at the phase's arithmetic intensity (flops per
-byte counted from the chapter's data) and the rate it achieved (those flops over its measured
-median time). A panel per thread count; a point's distance below the roof of its level is its
-distance from the bound (Williams, Waterman & Patterson, CACM 52(4), 2009).
+byte of traffic counted from the chapter's data: reads, writes and the line reads of
+allocating writes) and the rate it achieved (those flops over its measured median time). A
+panel per thread count: the cache-aware roofline (Ilic, Pratas & Sousa, IEEE CAL 2014), one
+roof per level, after the DRAM roofline of Williams, Waterman & Patterson (CACM 52(4), 2009).
 
     .venv/bin/python scripts/plot_roofline.py results/roofline.json --out results/roofline.png
+    .venv/bin/python scripts/plot_roofline.py docs/data/lessons/roofline.json --check
+
+--check draws nothing: it exits 1 if a phase ran faster than its bound allows (measured time
+below the bound: the model is broken there, and committed data must not hold one), or if the
+data lack a field the plot and the page read.
 """
 import argparse
 import json
@@ -19,6 +25,35 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+PHASE_FIELDS = ("phase", "bytes_read", "bytes_written", "bytes_allocated", "flops_double", "flops_float",
+                "working_set", "level", "bound_s", "memory_s", "arithmetic_s", "measured_s")
+
+
+def traffic(p):
+    """A phase's bytes: reads, writes and the line reads its allocating writes cost."""
+    return p["bytes_read"] + p["bytes_written"] + p["bytes_allocated"]
+
+
+def problems(data):
+    """What --check refuses: missing fields, and phases measured faster than their bound."""
+    found = []
+    for roof in data.get("roofs", []):
+        for level in roof["levels"]:
+            if "write" not in level:
+                found.append(f"roofs at {roof['threads']} thread(s): level {level['name']} has no write roof")
+    for r in data.get("runs", []):
+        name = f"{r['chapter']}@{r['threads']} on {r['mesh']}"
+        for p in r["phases"]:
+            missing = [f for f in PHASE_FIELDS if f not in p]
+            if missing:
+                found.append(f"{name} {p.get('phase', '?')}: no {', '.join(missing)}")
+            elif p["measured_s"] < p["bound_s"]:
+                found.append(f"{name} {p['phase']}: measured {p['measured_s'] * 1e3:.3g} ms, below its bound "
+                             f"{p['bound_s'] * 1e3:.3g} ms ({100 * p['bound_s'] / p['measured_s']:.0f}% of the "
+                             "bound): a broken model")
+    return found
+
+
 MARKERS = {"forces": "o", "dfdx": "s", "compose": "^", "constraints": "v", "solve": "D"}
 
 
@@ -29,6 +64,8 @@ def roofs(ax, roof, x):
         ax.plot(x, np.minimum(peak, x * bw), lw=1, color="0.35")
         ax.text(x[0] * 1.3, x[0] * 1.3 * bw * 1.15, f"{level['name']} {bw:.0f} GB/s", fontsize=7,
                 color="0.25")
+        # The write roof of the level, dotted: a phase that mostly writes sits under it.
+        ax.plot(x, np.minimum(peak, x * level["write"] / 1e9), lw=0.8, color="0.55", ls=":")
     ax.axhline(peak, lw=1, color="0.35", ls="-")
     ax.axhline(roof["peak_float"] / 1e9, lw=1, color="0.6", ls="--")
     ax.text(x[-1], peak * 1.08, f"double peak {peak:.0f} Gflop/s", fontsize=7, ha="right")
@@ -48,7 +85,7 @@ def points(ax, runs, threads):
                 continue
             hollow = meshes.index(r["mesh"]) > 0  # a further mesh: hollow markers
             c = colours[r["chapter"]]
-            ax.scatter(flops / p["bytes"], flops / p["measured_s"] / 1e9, marker=MARKERS.get(p["phase"], "x"),
+            ax.scatter(flops / traffic(p), flops / p["measured_s"] / 1e9, marker=MARKERS.get(p["phase"], "x"),
                        s=28, facecolors="none" if hollow else c, edgecolors=c, linewidths=1)
     return chapters, colours, meshes
 
@@ -64,13 +101,23 @@ def legend(fig, chapters, colours, meshes):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("json", type=pathlib.Path)
-    parser.add_argument("--out", type=pathlib.Path, required=True, help="the PNG to write")
+    parser.add_argument("--out", type=pathlib.Path, help="the PNG to write")
+    parser.add_argument("--check", action="store_true", help="check the data, draw nothing")
     args = parser.parse_args()
+    if not args.check and args.out is None:
+        parser.error("give --out PNG, or --check")
     record = json.loads(args.json.read_text())
     data = record.get("data")
     if not data or not data.get("roofs"):
         print(f"plot_roofline.py: {args.json} has no roofline data (fem_lessons roofline --json)", file=sys.stderr)
         return 1
+    if args.check:
+        found = problems(data)
+        for line in found:
+            print(f"plot_roofline.py: {args.json}: {line}", file=sys.stderr)
+        if not found:
+            print(f"{args.json}: every phase at or under its bound")
+        return 1 if found else 0
     panels = data["roofs"]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels) + 2.2, 4.6), squeeze=False)
     x = np.logspace(-3, 2, 200)

@@ -48,6 +48,7 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // Tests that compare thread counts keep the count they set (off); the environment variable
   // FEM_ADAPTIVE_TEAM=0 turns it off for a whole program (to see what it prevents).
   AdaptiveTeam& adaptive_team() { return adaptive_team_; }
+  const AdaptiveTeam& adaptive_team() const { return adaptive_team_; }
 
  protected:
   // The PCG's preconditioner from the next step on (block Jacobi until then), and the
