@@ -12,7 +12,8 @@ roof per level, after the DRAM roofline of Williams, Waterman & Patterson (CACM 
 
 --check draws nothing: it exits 1 if a phase ran faster than its bound allows (measured time
 below the bound: the model is broken there, and committed data must not hold one), or if the
-data lack a field the plot and the page read.
+data lack a field the plot and the page read; data recorded with `fem_lessons roofline
+--provisional REASON` (a placeholder, the page says so in bold) get warnings instead.
 """
 import argparse
 import json
@@ -113,8 +114,12 @@ def main():
         return 1
     if args.check:
         found = problems(data)
+        provisional = data.get("provisional")
         for line in found:
-            print(f"plot_roofline.py: {args.json}: {line}", file=sys.stderr)
+            print(f"plot_roofline.py: {args.json}: {'warning: ' if provisional else ''}{line}", file=sys.stderr)
+        if provisional:
+            print(f"{args.json}: provisional data ({provisional}): re-record it before it is read")
+            return 0
         if not found:
             print(f"{args.json}: every phase at or under its bound")
         return 1 if found else 0
@@ -131,6 +136,8 @@ def main():
         ax.set_title(f"{roof['threads']} thread(s)", fontsize=10)
         ax.set_ylim(1e-3, roof["peak_float"] / 1e9 * 3)
     legend(fig, chapters, colours, meshes)
+    if data.get("provisional"):
+        fig.suptitle(f"PROVISIONAL, not to be read: {data['provisional']}", fontsize=9, color="C3")
     fig.tight_layout(rect=(0, 0, 1 - 2.0 / fig.get_figwidth(), 1))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=130)

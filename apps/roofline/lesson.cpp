@@ -68,9 +68,14 @@ std::string roofline_table(const LessonRun& run) {
     for (const ChapterInfo* c : chapters_of(run.args.get("other-chapters")))
       for (PlacedRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
         runs.push_back(std::move(r));
-  if (run.data) *run.data = json_data(roofs, runs);
-  return roofs_table(roofs) + "\n" + roofs_checked(roofs) + "\n" + chapters_table(runs) + "\n" +
-         phases_table(runs) + broken_bounds(runs) + sentence(run, roofs);
+  const std::string provisional = run.args.get("provisional");
+  if (run.data) *run.data = json_data(roofs, runs, provisional);
+  const std::string banner =
+      provisional.empty()
+          ? ""
+          : "**Provisional data, not a measurement to read: " + provisional + ".**\n\n";
+  return banner + roofs_table(roofs) + "\n" + roofs_checked(roofs) + "\n" + chapters_table(runs) +
+         "\n" + phases_table(runs) + broken_bounds(runs) + sentence(run, roofs);
 }
 
 void add_roofline_options(ArgParser& args) {
@@ -84,6 +89,8 @@ void add_roofline_options(ArgParser& args) {
               "10");
   args.option("roof-seconds", "S", "time per roof kernel", "0.2");
   args.flag("no-likwid", "skip likwid-bench's check of the roofs");
+  args.option("provisional", "REASON",
+              "mark the data provisional (the docs check then warns instead of refusing)", "");
 }
 
 }  // namespace

@@ -23,8 +23,13 @@ double phase_seconds(const StepProfile& p, const std::string& phase) {
 // The counters over `steps` steps, per step.
 ExecutedWork per_step(ExecutedWork e, int steps) {
   const double n = std::max(steps, 1);
-  return {e.steps / n, e.rotations / n, e.rotation_iterations / n, e.rotation_fallbacks / n,
-          e.team};
+  e.steps /= n;
+  e.rotations /= n;
+  e.rotation_iterations /= n;
+  e.rotation_fallbacks /= n;
+  e.regions /= n;
+  e.barriers /= n;
+  return e;  // the team is the last step's
 }
 
 // The stepper at the roofs' thread count: `warmup` steps, then `steps` measured.
@@ -53,6 +58,7 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
     run.team_max = std::max(run.team_max, team);
   }
   run.executed = per_step(executed().since(before), steps);
+  run.waiting_s = run.executed.regions * roofs.region_s + run.executed.barriers * roofs.barrier_s;
   std::vector<double> iterations, step;
   for (const StepProfile& p : profiles) {
     iterations.push_back(p.cg_iterations);

@@ -29,8 +29,9 @@ struct PlacedRun {
   int team_min = 0,
       team_max = 0;  // threads the measured steps ran on (0: the stepper does not say)
   std::vector<PhasePoint> phases;
-  double step_s = 0.0;   // median step
-  double bound_s = 0.0;  // sum of the phases' bounds
+  double step_s = 0.0;     // median step
+  double bound_s = 0.0;    // sum of the phases' bounds
+  double waiting_s = 0.0;  // the step's regions and barriers at their measured costs
 };
 
 // `chapter` on `scene` under each of `roofs` (one per thread count; a chapter that does not

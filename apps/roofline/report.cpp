@@ -43,6 +43,12 @@ std::string threads_ran(const PlacedRun& r) {
   return std::to_string(r.team_min) + "-" + std::to_string(r.team_max);
 }
 
+// Regions and barriers per step: "12 + 340".
+std::string syncs(const PlacedRun& r) {
+  if (r.executed.regions + r.executed.barriers <= 0) return "-";
+  return sig(r.executed.regions) + " + " + sig(r.executed.barriers);
+}
+
 double of_bound(const PhasePoint& p) { return p.bound_s / std::max(p.measured_s, 1e-12); }
 
 // Which roof the bound is: the bytes' time or the flops'.
@@ -108,6 +114,8 @@ std::string roofs_checked(const std::vector<Roofs>& roofs) {
       out << "| " << l.level.name << " write, GB/s | " << r.threads << " | "
           << fixed(l.write / 1e9, 1) << " | " << against(l.write, l.likwid_write) << " | |\n";
     }
+    out << "| one barrier, one parallel region, us | " << r.threads << " | "
+        << fixed(1e6 * r.barrier_s, 2) << ", " << fixed(1e6 * r.region_s, 2) << " | | |\n";
     out << "| peak multiply-add, double, Gflop/s | " << r.threads << " | "
         << fixed(r.peak_double / 1e9, 1) << " | " << against(r.peak_double, r.likwid_peak) << " | "
         << fixed(r.core_flops / 1e9, 1) << " |\n";
@@ -138,9 +146,8 @@ std::string roofs_check(const std::vector<Roofs>& roofs) {
 std::string chapters_table(const std::vector<PlacedRun>& runs) {
   std::ostringstream out;
   out << "| chapter | mesh | threads ran | CG it. | Newton it. per element | step, ms | the roofs "
-         "allow, ms | of the bound | the phase furthest above its roof |\n| --- | --- | ---: | "
-         "---: "
-         "| ---: | ---: | ---: | ---: | --- |\n";
+         "allow, ms | of the bound | syncs per step | waiting, ms | the phase furthest above its "
+         "roof |\n| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n";
   for (const PlacedRun& r : runs) {
     const double newton =
         r.executed.rotations > 0 ? r.executed.rotation_iterations / r.executed.rotations : 0.0;
@@ -148,12 +155,13 @@ std::string chapters_table(const std::vector<PlacedRun>& runs) {
         << sig(r.iterations) << " | " << (newton > 0 ? fixed(newton, 2) : "-") << " | "
         << sig(1e3 * r.step_s) << " | ";
     if (r.phases.empty()) {
-      out << "not counted | | |\n";
+      out << "not counted | | | | |\n";
       continue;
     }
     const PhasePoint& gap = widest_gap(r);
     out << sig(1e3 * r.bound_s) << " | " << fixed(100 * r.bound_s / r.step_s, 0) << "% | "
-        << gap.work.phase << " (" << sig(1e3 * (gap.measured_s - gap.bound_s)) << " ms above) |\n";
+        << syncs(r) << " | " << sig(1e3 * r.waiting_s) << " | " << gap.work.phase << " ("
+        << sig(1e3 * (gap.measured_s - gap.bound_s)) << " ms above) |\n";
   }
   return out.str();
 }
@@ -190,8 +198,10 @@ std::string broken_bounds(const std::vector<PlacedRun>& runs) {
          "machine?), or a level too far out.**\n";
 }
 
-std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs) {
+std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs,
+                      const std::string& provisional) {
   nlohmann::json data = {{"roofs", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
+  if (!provisional.empty()) data["provisional"] = provisional;
   for (const Roofs& r : roofs) {
     nlohmann::json levels = nlohmann::json::array();
     for (const LevelRoof& l : r.levels)
@@ -210,6 +220,8 @@ std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedR
                              {"clock", r.clock},
                              {"core_loads", r.core_loads},
                              {"core_flops", r.core_flops},
+                             {"barrier_s", r.barrier_s},
+                             {"region_s", r.region_s},
                              {"levels", levels}});
   }
   for (const PlacedRun& r : runs) {
@@ -239,6 +251,9 @@ std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedR
                             {"rotation_fallbacks", r.executed.rotation_fallbacks},
                             {"step_s", r.step_s},
                             {"bound_s", r.bound_s},
+                            {"regions", r.executed.regions},
+                            {"barriers", r.executed.barriers},
+                            {"waiting_s", r.waiting_s},
                             {"phases", phases}});
   }
   return data.dump();

@@ -22,6 +22,9 @@ std::string phases_table(const std::vector<PlacedRun>& runs);
 // The runs with a phase above 100% of its bound, named in bold (empty if none).
 std::string broken_bounds(const std::vector<PlacedRun>& runs);
 // Everything above as one JSON object: {"roofs": [...], "runs": [...]}.
-std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs);
+// `provisional`, if not empty, says why the data are not to be read (the docs check warns
+// about their broken bounds instead of refusing them).
+std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs,
+                      const std::string& provisional = "");
 
 }  // namespace fem::roofline

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "apps/roofline/sync_cost.hpp"
 #include "common/lesson.hpp"
 
 namespace fem::roofline {
@@ -29,6 +30,8 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
   roofs.peak_float = peak_flops_float(threads, seconds);
   if (likwid) roofs.likwid_peak = likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds);
   roofs.clock = measured_clock();
+  roofs.barrier_s = barrier_seconds(threads);
+  roofs.region_s = region_seconds(threads);
   roofs.core_loads = kLoadsPerCycle * double_lanes() * 8.0 * roofs.clock * threads;
   roofs.core_flops = kFmasPerCycle * double_lanes() * 2.0 * roofs.clock * threads;
   return roofs;

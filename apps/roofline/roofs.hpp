@@ -29,6 +29,7 @@ struct Roofs {
   // The cores' own limits at that clock: kLoadsPerCycle packet loads and kFmasPerCycle packet
   // multiply-adds per cycle per thread.
   double core_loads = 0.0, core_flops = 0.0;  // bytes/s, flops/s
+  double barrier_s = 0.0, region_s = 0.0;     // one barrier, one parallel region (sync_cost)
 };
 
 // Two loads and two multiply-adds issued per cycle: the x86 cores since Haswell and Zen 2

@@ -14,9 +14,12 @@ std::vector<PhaseWork> count_work(const HalfBytesStepper& stepper, const Scene& 
 ExecutedWork executed_work(const HalfBytesStepper& stepper) {
   const BatchedElements& e = stepper.batched_elements();
   const double elements = stepper.elements().shapes().size();
-  return {elements > 0 ? double(e.total_rotations()) / elements : 0.0, double(e.total_rotations()),
-          double(e.total_newton_iterations()), double(e.total_fallbacks()),
-          ch09::executed_work(stepper).team};
+  ExecutedWork w = ch09::executed_work(stepper);  // the team and the synchronizations
+  w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;
+  w.rotations = double(e.total_rotations());
+  w.rotation_iterations = double(e.total_newton_iterations());
+  w.rotation_fallbacks = double(e.total_fallbacks());
+  return w;
 }
 
 }  // namespace fem::ch12

@@ -8,10 +8,12 @@
 #include "chapters/01_naive/work.hpp"
 #include "chapters/07_block_sparse/work.hpp"
 #include "chapters/08_element_kernels/work.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/work.hpp"
 #include "chapters/12_half_the_bytes/work.hpp"
 #include "chapters/registry.hpp"
+#include "common/threads.hpp"
 #include "support.hpp"
 
 using namespace fem;
@@ -211,4 +213,25 @@ TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roo
     CHECK(levels[2].capacity == std::size_t(32 << 20) / threads);
     CHECK(levels.back().working_set * threads >= std::size_t(4) * (32 << 20));
   }
+}
+
+TEST_CASE("roofline: a threaded step counts its team and its synchronizations", "[roofline]") {
+  const Scene scene = test::test_scene("cantilever");
+  const ChapterInfo& chapter = find_chapter("09");
+  const auto stepper = chapter.make(scene, {});
+  auto* threads = dynamic_cast<ch09::ThreadsStepper*>(stepper.get());
+  REQUIRE(threads);
+  threads->adaptive_team().set_enabled(false);  // the given team on every step
+  const ThreadCountScope team(2);
+  State state = rest_state(scene);
+  stepper->step(state);
+  REQUIRE(chapter.work.executed);
+  const ExecutedWork before = chapter.work.executed(*stepper);
+  stepper->step(state);
+  const ExecutedWork e = chapter.work.executed(*stepper).since(before);
+  CHECK(e.team == 2.0);
+  CHECK(e.steps == 1.0);
+  CHECK(e.regions >= 1.0);
+  // Every PCG iteration ends worksharing loops (a barrier each): at least one per iteration.
+  CHECK(e.barriers >= stepper->profile().cg_iterations);
 }
