@@ -21,24 +21,35 @@ void FusedVCycle::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunk
   reduced_.prepare(A, chunks);  // the hierarchy's numbers, then their float copies
 }
 
+bool FusedVCycle::fused() const {
+  const ch10::Level<3>& source = *reduced_.fine_level().source;
+  return !source.coarsest && !source.rows.serial;
+}
+
+void FusedVCycle::enter(int first, int last, const Eigen::VectorXd& r) {
+  r_.segment(3 * first, 3 * (last - first)) =
+      r.segment(3 * first, 3 * (last - first)).cast<float>();
+  fused_entry(reduced_.fine_level(), first, last, r_);
+}
+
+void FusedVCycle::complete(Eigen::VectorXd& s, const RowsCall& finish) {
+  multigrid_.refresh_rule().count_cycle();  // the refresh rule counts V-cycles
+  fused_cycle(reduced_.fine_level(), reduced_.coarse_levels(), 0, r_, s_, [&](int first, int last) {
+    s.segment(3 * first, 3 * (last - first)) =
+        s_.segment(3 * first, 3 * (last - first)).cast<double>();
+    finish(first, last);
+  });
+}
+
 void FusedVCycle::apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r,
                         Eigen::VectorXd& s) {
-  auto& fine = reduced_.fine_level();
-  const ch10::Level<3>& source = *fine.source;
-  if (source.coarsest || source.rows.serial) {  // one level, or one thread: nothing to fuse
+  if (!fused()) {  // one level, or one thread: nothing to fuse
     reduced_.apply(chunks, r, s);
     return;
   }
-  multigrid_.refresh_rule().count_cycle();  // the refresh rule counts V-cycles
-  ch09::for_parts(source.rows.part, true, [&](int first, int last) {
-    r_.segment(3 * first, 3 * (last - first)) =
-        r.segment(3 * first, 3 * (last - first)).cast<float>();
-    fused_entry(fine, first, last, r_);
-  });
-  fused_cycle(fine, reduced_.coarse_levels(), 0, r_, s_, [&](int first, int last) {
-    s.segment(3 * first, 3 * (last - first)) =
-        s_.segment(3 * first, 3 * (last - first)).cast<double>();
-  });
+  ch09::for_parts(fine_part(), true, [&](int first, int last) { enter(first, last, r); });
+  const auto nothing = [](int, int) {};
+  complete(s, nothing);
 }
 
 }  // namespace fem::ch13

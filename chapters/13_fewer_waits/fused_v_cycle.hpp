@@ -91,6 +91,21 @@ void correct_from_below(Level& level, std::vector<Coarse>& coarse, std::size_t n
   fused_cycle(below, coarse, next + 1, below.vectors.b, below.vectors.x, [](int, int) {});
 }
 
+// A call f(first, last) passed by reference to a callable of any type, without std::function
+// (which may allocate): the callable must outlive the call.
+class RowsCall {
+ public:
+  template <class F>
+  RowsCall(const F& f)  // NOLINT: converts from any callable, as std::function does
+      : call_([](const void* f, int first, int last) { (*static_cast<const F*>(f))(first, last); }),
+        callable_(&f) {}
+  void operator()(int first, int last) const { call_(callable_, first, last); }
+
+ private:
+  void (*call_)(const void*, int, int);
+  const void* callable_;
+};
+
 // The float V-cycle of the hierarchy as the PCG's preconditioner, run by fused_cycle: the same
 // numbers (the float levels that `reduced` converts in prepare), the same result, four waits
 // fewer per cycle on a three-level hierarchy (fused_v_cycle.cpp counts them).
@@ -103,6 +118,16 @@ class FusedVCycle final : public ch09::Preconditioner {
   // s = M r: r into float inside the finest level's first step, s back to double inside its
   // last. By every thread of the PCG's team.
   void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+
+  // The same cycle in two parts, for a solver that runs the first inside a loop of its own:
+  // enter(first, last, r) on every row block of fine_part() as r's rows are written, then
+  // complete(s, finish) by every thread after that loop's barrier, which calls
+  // finish(first, last) on the rows of s as they are written. Only where fused() (a finest
+  // level shared by the team, with a level below).
+  bool fused() const;
+  const std::vector<int>& fine_part() const { return reduced_.fine_level().source->rows.part; }
+  void enter(int first, int last, const Eigen::VectorXd& r);
+  void complete(Eigen::VectorXd& s, const RowsCall& finish);
 
  private:
   ch12::ReducedVCycle<float>& reduced_;

@@ -1,4 +1,4 @@
-// Chapter 13: chapter 12's step with the fused V-cycle as the PCG's preconditioner (see
+// Chapter 13: chapter 12's step with the fused V-cycle inside the single-reduction PCG (see
 // stepper.hpp).
 #include "chapters/13_fewer_waits/stepper.hpp"
 
@@ -16,8 +16,14 @@ ch12::ReducedVCycle<float>& float_v_cycle(ch12::HalfBytesStepper& stepper) {
 FewerWaitsStepper::FewerWaitsStepper(const Scene& scene, const SolverSettings& settings,
                                      const ch10::MultigridStepperSettings& multigrid)
     : HalfBytesStepper(scene, settings, ch12::Arithmetic::single, multigrid),
-      fused_(float_v_cycle(*this), this->multigrid()) {
+      fused_(float_v_cycle(*this), this->multigrid()),
+      single_reduction_(fused_.fine_part(), scene_.constraints) {
   use_preconditioner(fused_, "13_fewer_waits");
+}
+
+SolveStats FewerWaitsStepper::solve_filtered_system(Eigen::VectorXd& y) {
+  if (!fused_.fused()) return HalfBytesStepper::solve_filtered_system(y);
+  return single_reduction_.solve(system_matrix(), fused_, system_rhs(), settings_, y);
 }
 
 }  // namespace fem::ch13
