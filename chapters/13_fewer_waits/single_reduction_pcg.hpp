@@ -1,5 +1,5 @@
 // Chapter 13's PCG with one wait per reduction: Chronopoulos and Gear's form of CG (1989).
-// Chapter 09's PCG meets its team four times per iteration outside the preconditioner: after
+// The PCG of chapter 09 meets its team four times per iteration outside the preconditioner: after
 // q = A p (for p . q), after the update of y and r (for r . r), after s = M r (for r . s),
 // and after p = s + beta p (q = A p reads p's neighbours). Here one loop computes w = A s and
 // both dot products of the next step, gamma = r . s and delta = s . w, and the directions
