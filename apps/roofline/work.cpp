@@ -15,6 +15,7 @@
 #include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
+#include "chapters/13_fewer_waits/stepper.hpp"
 
 namespace fem::roofline {
 
@@ -206,7 +207,16 @@ const S* as(const Stepper& stepper) {
 std::vector<PhaseWork> count_work(const Stepper& wrapped, const Scene& scene, int it,
                                   std::string& counted_as) {
   const Stepper& s = unwrapped(wrapped);
-  // Most derived first: 12 derives from 11, 11 from 10, 10 from 09, 09 from 08.
+  // Most derived first: 13 derives from 12, 12 from 11, 11 from 10, 10 from 09, 09 from 08.
+  if (const auto* c = as<ch13::FewerWaitsStepper>(s)) {
+    // Chapter 12's matrices and cycle; its single-reduction PCG streams two more vectors per
+    // iteration (w = A s written and read, q updated: read and written).
+    counted_as = "13";
+    std::vector<PhaseWork> work = multigrid_chapter(*c, scene, it, true, true);
+    work.back().bytes += (it + 1.0) * 4 * sizes(scene).vector_bytes;
+    work.back().working_set += 2 * sizes(scene).vector_bytes;
+    return work;
+  }
   if (const auto* c = as<ch12::HalfBytesStepper>(s)) {
     counted_as = "12";
     return multigrid_chapter(*c, scene, it, true, c->arithmetic() == ch12::Arithmetic::single);
