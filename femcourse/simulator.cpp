@@ -134,13 +134,16 @@ struct Body::Impl {
   fem::Scene scene;  // first: the stepper is built from it and may keep a reference
   std::unique_ptr<fem::Stepper> stepper;
   fem::State state;
+  fem::SolverSettings solver;
   std::vector<fem::ExternalForce> forces;  // reused: set_forces allocates once
+  bool forces_set = false;                 // set_forces was called: forces replace the scene's
   StepProfile profile;
   std::string chapter;
   long long steps = 0;
 
-  Impl(fem::Scene s, const StepperFactory& make, const fem::SolverSettings& solver, std::string id)
-      : scene(std::move(s)), chapter(std::move(id)) {
+  Impl(fem::Scene s, const StepperFactory& make, const fem::SolverSettings& settings,
+       std::string id)
+      : scene(std::move(s)), solver(settings), chapter(std::move(id)) {
     stepper = make(scene, solver);
     state = fem::rest_state(scene);
   }
@@ -185,6 +188,7 @@ void Body::set_forces(const std::vector<NodeForce>& forces) {
   b.forces.clear();  // keeps the capacity
   for (const NodeForce& f : forces) b.forces.push_back({f.node, vector_of(f.force)});
   b.stepper->set_external_forces(b.forces);
+  b.forces_set = true;
 }
 
 int Body::num_nodes() const { return impl_->scene.mesh.num_nodes(); }
@@ -202,6 +206,22 @@ std::array<double, 3> Body::position(int node) const {
 double Body::time() const { return static_cast<double>(impl_->steps) * impl_->scene.dt; }
 const StepProfile& Body::profile() const { return impl_->profile; }
 const std::string& Body::chapter() const { return impl_->chapter; }
+void Body::set_chapter(const std::string& chapter) {
+  const fem::ChapterInfo& info = chapter_of(chapter);
+  impl_->stepper = info.make(impl_->scene, impl_->solver);
+  impl_->stepper->set_external_forces(impl_->forces_set ? impl_->forces
+                                                        : impl_->scene.external_forces);
+  impl_->chapter = info.id;
+}
+
+void Body::set_state(const fem::State& state) {
+  if (state.x.size() != impl_->state.x.size() || state.v.size() != impl_->state.v.size())
+    refuse("set_state: the state has " + std::to_string(state.x.size() / 3) + " nodes, the body " +
+           std::to_string(num_nodes()));
+  impl_->state.x = state.x;
+  impl_->state.v = state.v;
+}
+
 const fem::Scene& Body::scene() const { return impl_->scene; }
 const fem::State& Body::state() const { return impl_->state; }
 const fem::Stepper& Body::stepper() const { return *impl_->stepper; }

@@ -109,6 +109,9 @@ class Body {
   double time() const;                 // [s] since rest
   const StepProfile& profile() const;  // of the last step
   const std::string& chapter() const;  // the chapter's id, e.g. "12_half_the_bytes"
+  // Steps on with another chapter's stepper from the current state (the viewer's chapter
+  // switch); throws std::invalid_argument for an unknown chapter and changes nothing then.
+  void set_chapter(const std::string& chapter);
 
   // ---- advanced: the course's own types (include "common/stepper.hpp") -----------------
   // A stepper of one's own: any fem::Stepper built from the body's scene (docs/library.md).
@@ -120,6 +123,9 @@ class Body {
   Body(fem::Scene scene, const fem::SolverSettings& solver, const std::string& chapter);
   const fem::Scene& scene() const;
   const fem::State& state() const;
+  // Continues from another body's state of the same mesh (the viewer after a change of
+  // material); throws std::invalid_argument for another number of nodes.
+  void set_state(const fem::State& state);
   const fem::Stepper& stepper() const;
 
  private:

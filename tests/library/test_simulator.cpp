@@ -218,3 +218,26 @@ TEST_CASE("a diverging step throws StepDiverged, naming the step", "[library]") 
     CHECK(!e.reason.empty());
   }
 }
+
+TEST_CASE("a chapter switch continues from the state, as the viewer's does", "[library]") {
+  const fem::Scene scene = fem::test::test_scene("cantilever");
+  Body body(description_of(scene));
+  for (int k = 0; k < 5; ++k) body.step();
+  fem::State expected = body.state();
+  body.set_chapter("11");
+  CHECK(body.chapter() == fem::find_chapter("11").id);
+  const auto stepper = fem::make_stepper("11", scene);
+  for (int k = 0; k < 5; ++k) {
+    body.step();
+    stepper->step(expected);
+  }
+  CHECK(same_bits(body.positions(), expected.x));
+  CHECK_THROWS_AS(body.set_chapter("99_nothing"), std::invalid_argument);
+  CHECK(body.chapter() == fem::find_chapter("11").id);
+  Body other(description_of(scene));
+  other.set_state(body.state());
+  CHECK(same_bits(other.positions(), body.state().x));
+  fem::State wrong = body.state();
+  wrong.x.conservativeResize(wrong.x.size() - 3);
+  CHECK_THROWS_AS(other.set_state(wrong), std::invalid_argument);
+}
