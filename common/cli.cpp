@@ -112,6 +112,8 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
+const char* help_notice = nullptr;  // constant-initialized: set before any use
+
 std::string ArgParser::help() const {
   std::ostringstream out;
   out << "usage: " << program_ << " [options]\n\n" << summary_ << "\n\noptions:\n";
@@ -123,6 +125,7 @@ std::string ArgParser::help() const {
     out << "\n";
   }
   out << "  --help                  print this help and exit\n";
+  if (help_notice) out << "\n" << help_notice << "\n";
   return out.str();
 }
 

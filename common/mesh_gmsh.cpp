@@ -10,11 +10,20 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "common/cli.hpp"
 #include "common/mesh.hpp"
 
 // Named by fem_mesh_gmsh's link option -u (CMakeLists.txt): it pulls this file into every
 // program that links the reader, so that its load_mesh wins over fem_fallbacks'.
 extern "C" void fem_mesh_gmsh_reader() {}
+
+namespace {
+const bool notice_set = (fem::help_notice =
+                             "This program links the gmsh SDK (GPL-2.0-or-later with exceptions): "
+                             "its own code is MIT, a binary of it passed on is a combined work "
+                             "under the GPL's terms (README.md, License).",
+                         true);
+}  // namespace
 
 namespace fem {
 namespace {
