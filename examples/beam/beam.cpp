@@ -28,7 +28,11 @@ int main(int argc, char** argv) {
         for (int p = 0; p < 6; ++p) {
           std::array<int, 3> c{i, j, k};
           int tet[4] = {node(i, j, k), 0, 0, 0};
-          for (int s = 0; s < 3; ++s) tet[s + 1] = (++c[axes[p][s]], node(c[0], c[1], c[2]));
+          for (int s = 0; s < 3;
+               ++s) {  // a path along the edges from corner (i,j,k) to the far one
+            ++c[axes[p][s]];
+            tet[s + 1] = node(c[0], c[1], c[2]);
+          }
           if (p >= 3) std::swap(tet[2], tet[3]);  // odd permutations turn the other way
           beam.tetrahedra.insert(beam.tetrahedra.end(), tet, tet + 4);
         }
