@@ -8,6 +8,7 @@
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
 #include "common/deformation.hpp"
+#include "common/run_lock.hpp"
 #include "common/stepper.hpp"
 #include "common/vtk.hpp"
 #include "femcourse/simulator.hpp"
@@ -32,7 +33,7 @@ void add_options(ArgParser& args) {
   args.option("watch", "NODE", "print this node's final position, 17 digits (-1: none)", "-1");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
-              "scene's name there is replaced)",
+              "scene's name there is replaced; a folder another run is writing is refused)",
               "out/sim");
 }
 
@@ -65,18 +66,20 @@ Run run_from_args(const ArgParser& args) {
 void print_progress(int k, const Run& run, const Scene& scene, const StepProfile& p) {
   std::cout << "  step " << k << "/" << run.steps << "  t = " << k * scene.dt << " s  step "
             << p.step.seconds * 1e3 << " ms  CG " << p.cg_iterations << " it  residual "
-            << p.relative_residual << "\n";
+            << p.relative_residual << std::endl;
 }
 
 // The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
-// for a step that diverged (an error) or left the body implausible (counted).
+// for a step that diverged (an error) or that left the body in trouble (common/deformation.hpp).
 void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& series) {
   const Scene& scene = body.scene();
   const State& state = body.state();
   if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
+  const DeformationProbe probe(scene);
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
   for (int k = 1; k <= run.steps; ++k) {
+    const auto start = std::chrono::steady_clock::now();
     try {
       body.step();
     } catch (const femcourse::StepDiverged& e) {
@@ -84,7 +87,13 @@ void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& s
                                e.reason +
                                "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
     }
-    deformation.after_step(k, check_deformation(scene.mesh, state.x));
+    // The first step allocates the stepper's buffers: the estimate is taken from the second.
+    if (k == 2)
+      announce_long_run(
+          "fem_sim",
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+          run.steps);
+    deformation.after_step(k, probe.check(state));
     if (series && k % run.every == 0)
       series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
     if (k % report_every == 0 || k == run.steps)
@@ -103,7 +112,24 @@ void print_watched(const Run& run, const femcourse::Body& body) {
   std::cout.precision(6);
 }
 
+// The output folder is this run's from here to the end (common/run_lock.hpp): a second
+// fem_sim into it is refused before any work, rather than each removing the other's frames.
+std::optional<RunLock> lock_output(const ArgParser& args, const Run& run) {
+  std::optional<RunLock> lock;
+  if (run.every == 0) return lock;
+  try {
+    lock.emplace(args.get("out"), "fem_sim");
+  } catch (const FolderInUse& e) {
+    throw UsageError(std::string("--out: ") + e.what());
+  }
+  if (lock->stale_pid() > 0)
+    std::cout << "note: " << args.get("out") << " held the lock of a run that is gone (pid "
+              << lock->stale_pid() << "); taken over\n";
+  return lock;
+}
+
 void run_scene(const ArgParser& args, const Run& run) {
+  const std::optional<RunLock> lock = lock_output(args, run);
   femcourse::Body body(scene_from_args(args), run.solver, run.chapter->id);
   const Scene& scene = body.scene();
   if (run.watch >= scene.mesh.num_nodes())
@@ -111,7 +137,8 @@ void run_scene(const ArgParser& args, const Run& run) {
                      std::to_string(scene.mesh.num_nodes()) + " nodes");
   std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
-            << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s\n";
+            << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s"
+            << std::endl;
   const bool threaded = body.stepper().uses_threads();
   std::cout << "threads: " << (threaded ? run.threads : 1)
             << (threaded ? "" : " (this chapter is single-threaded)") << "\n";

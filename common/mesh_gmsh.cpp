@@ -54,6 +54,33 @@ void reset_gmsh() {
   gmsh_initialized = false;
 }
 
+// Any volume element other than the 4-node tetrahedron (gmsh type 4) is refused, with the
+// types and counts found: loading the tetrahedra alone would drop the rest of the body
+// silently (tetrahedra beside hexahedra), and second-order tetrahedra (10 nodes) are another
+// element than the linear one the steppers integrate.
+void refuse_other_volume_elements(const std::string& path) {
+  std::vector<int> types;
+  gmsh::model::mesh::getElementTypes(types, 3);
+  std::string found;
+  for (const int type : types) {
+    if (type == 4) continue;
+    std::vector<std::size_t> tags, nodes;
+    gmsh::model::mesh::getElementsByType(type, tags, nodes);
+    std::string name;
+    int dim = 0, order = 0, num_nodes = 0, primary = 0;
+    std::vector<double> local;
+    gmsh::model::mesh::getElementProperties(type, name, dim, order, num_nodes, local, primary);
+    found += (found.empty() ? "" : ", ") + std::to_string(tags.size()) + " " + name +
+             " (gmsh type " + std::to_string(type) + ", " + std::to_string(num_nodes) + " nodes)";
+  }
+  if (found.empty()) return;
+  gmsh::clear();
+  fail(path, "holds volume elements other than 4-node tetrahedra: " + found +
+                 ". The programs take linear tetrahedra only: in gmsh, mesh the volume with "
+                 "tetrahedra only (no recombination, Mesh.RecombineAll = 0) at first order "
+                 "(gmsh.model.mesh.setOrder(1), or Mesh.ElementOrder = 1), and save again");
+}
+
 }  // namespace
 
 TetMesh load_mesh(const std::string& path) {
@@ -74,6 +101,7 @@ TetMesh load_mesh(const std::string& path) {
     fail(path, "gmsh cannot read it as a mesh file");
   }
 
+  refuse_other_volume_elements(path);
   std::vector<std::size_t> node_tags;
   std::vector<double> coords, params;
   gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, false, false);
