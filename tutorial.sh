@@ -80,7 +80,7 @@ commands:
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
              tables (fem_lessons), the figures of chapters 10-12 (fem-tools plots figures), the
-             chapter diffs (docs/diffs/) and the viewer's screenshot
+             chapter diffs (docs/diffs/), the cantilever's animation (docs/images/cantilever.gif) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
   lessons    measure the lesson tables (fem_lessons, fem-tools runs pyamg; a few minutes),
@@ -94,7 +94,8 @@ commands:
              --out DIR for another run folder, other arguments go to fem_lessons roofline
              (--chapters 12,12_mine, --meshes, --steps; fem_lessons roofline --help)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
-             out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
+             out/sim/cantilever.pvd in ParaView) and render them to out/sim/cantilever.gif
+             (--out DIR for another folder; docs renders docs/images/cantilever.gif)
   viewer-bench
              build and measure the viewer's frame rate per chapter on the poster-sized mesh,
              headless (Xvfb): results/viewer.json, shown in the README by docs
@@ -458,6 +459,9 @@ docs() {
   fem_tools docs update
   log "chapter diffs (docs/diffs/)"
   fem_tools docs diffs
+  log "the cantilever's animation (docs/images/cantilever.gif, from ./tutorial.sh sim's run)"
+  sim --out out/docs_sim >/dev/null
+  cp out/docs_sim/cantilever.gif docs/images/cantilever.gif
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then
     log "viewer screenshot (headless, Xvfb): docs/images/viewer.png"
     xvfb-run -a -s "-screen 0 1280x800x24" "$BUILD_DIR/fem_viewer" --frames 90 \
@@ -465,14 +469,20 @@ docs() {
   fi
 }
 
+# The run's folder gets the frames and the gif: a tracked file (docs/images/cantilever.gif) is
+# written only by ./tutorial.sh docs, which exists to regenerate the docs.
 sim() {
+  local out=out/sim args=("$@") i
+  for ((i = 0; i < ${#args[@]}; i++)); do
+    [ "${args[i]}" = --out ] && out="${args[i + 1]:-}"
+  done
   quiet_build
-  log "simulating the cantilever on the poster-sized mesh (VTK frames in out/sim/)"
-  "$BUILD_DIR/fem_sim" --out out/sim --every 4 "$@"
-  log "rendering the frames to docs/images/cantilever.gif"
+  log "simulating (VTK frames in $out/)"
+  "$BUILD_DIR/fem_sim" --out "$out" --every 4 "$@"
   local pvd
-  pvd=$(ls -t out/sim/*.pvd | head -n 1)
-  fem_tools plots gif "$pvd" --out docs/images/cantilever.gif
+  pvd=$(ls -t "$out"/*.pvd | head -n 1)
+  log "rendering the frames to ${pvd%.pvd}.gif"
+  fem_tools plots gif "$pvd" --out "${pvd%.pvd}.gif"
 }
 
 viewer() {

@@ -29,6 +29,44 @@ def run(*args, cwd=ROOT):
     return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd)
 
 
+def links_cases(tmp, run_json):
+    """The hand-in check reads and writes only regular files inside the hand-in."""
+    handin = [sys.executable, "-m", "femtools", "course", "handin", "--no-tests"]
+    outside = tmp / "outside"
+    outside.mkdir()
+    # A dangling link where the check would write the diff: nothing is created outside.
+    dangling = tmp / "handin_dangling"
+    dangling.mkdir()
+    (dangling / "bench.json").write_bytes(run_json)
+    (dangling / "06_custom_pcg.diff").symlink_to(outside / "written_through_the_link.diff")
+    p = run(*handin, dangling)
+    check("handin-check refuses a hand-in holding a dangling link, naming it",
+          p.returncode != 0 and "symbolic links" in p.stderr and "06_custom_pcg.diff" in p.stderr,
+          p.stdout + p.stderr)
+    check("... and writes nothing through it", not any(outside.iterdir()), list(outside.iterdir()))
+    # A link to a file outside: not read.
+    (outside / "bench.json").write_bytes(run_json)
+    linked = tmp / "handin_linked"
+    linked.mkdir()
+    (linked / "bench.json").symlink_to(outside / "bench.json")
+    p = run(*handin, linked)
+    check("handin-check refuses bench.json as a link to a file outside the hand-in",
+          p.returncode != 0 and "symbolic links" in p.stderr and "bench.json" in p.stderr, p.stderr)
+    # Names that climb out of chapters/: in the run's record, on the command line.
+    climbing = tmp / "handin_climbing"
+    climbing.mkdir()
+    record = json.loads(run_json)
+    record["chapters"][0]["chapter"] = "../../outside"
+    (climbing / "bench.json").write_text(json.dumps(record))
+    p = run(*handin, climbing)
+    check("handin-check refuses a chapter name with '..' in the run's record",
+          p.returncode != 0 and "'../../outside' is not a plain name" in p.stderr, p.stderr)
+    (climbing / "bench.json").write_bytes(run_json)
+    p = run(*handin, climbing, "--variant", "../06_custom_pcg")
+    check("handin-check refuses a --variant with '..'",
+          p.returncode != 0 and "not a plain name" in p.stderr, p.stderr)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--bench", required=True)
@@ -55,7 +93,7 @@ def main():
               and (student / "bench.json").read_bytes() == first, p.stdout[-300:] + p.stderr)
         p = run(*bench, "--out", student, "--no-solvers", "--replace")
         check("--replace replaces it and says so",
-              p.returncode == 0 and "replacing the run that was there" in p.stdout, p.stdout[-300:])
+              p.returncode == 0 and "replaced the run that was there" in p.stdout, p.stdout[-300:])
         p = run(*bench, "--out", student, "--replace")  # the hand-in: a full run again
         first = (student / "bench.json").read_bytes()
 
@@ -102,6 +140,7 @@ def main():
         for png in PLOTS:
             same = (teacher / png).exists() and (teacher / png).read_bytes() == (student / png).read_bytes()
             check(f"the teacher regenerates the student's {png} byte for byte", same)
+        links_cases(tmp, first)
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0
 

@@ -18,6 +18,7 @@ from femtools.args import command_parser
 from femtools.results.common import BASELINE, ResultsError, cache_summary, die, machine_summary
 from femtools.results.phases import PHASE_LABELS, compared
 from femtools.results.schema import load_checked
+from femtools.files import replacing
 
 from femtools.paths import ROOT
 REFERENCE = ROOT / "docs" / "data" / "bench.json"
@@ -124,7 +125,8 @@ def plot(rows, phases, differences, run_name, reference_name, path):
     fig.text(0.01, 0.005, f"what differs ({run_name} | {reference_name}): {note}", fontsize=6.5,
              color="0.35", ha="left", va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.05, 1, 1))
-    fig.savefig(path, dpi=110)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)
 
 

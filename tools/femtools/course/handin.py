@@ -12,9 +12,16 @@ For each variant of the run (a chapter whose folder has a variant_of file):
   3. its tests (`ctest -L chNN_NAME`: the checks every chapter passes) pass in the build.
 And for the run: the plots regenerate from the JSON alone, pixel for pixel as handed in, and a
 run measured on a busy machine is named (its ratios are not to be graded: ask for a rerun).
-Prints one line per check and 'N passed, M failed' last; exits 1 on a failure."""
+It reads and writes only regular files inside the hand-in (the run's folder, the variants'
+folders): a symbolic link anywhere in them, or a name with '..' or '/' in the run's record or on
+the command line, is refused before anything is read through it or written. Prints one line per
+check and 'N passed, M failed' last; exits 1 on a failure.
+
+A hand-in is code: its tests build the student's CMake and C++ and run them with the rights of
+whoever checks (docs/coursework.md, "Checking a hand-in": in a throwaway container or user)."""
 import hashlib
 import json
+import os
 import pathlib
 import subprocess
 import tempfile
@@ -34,23 +41,66 @@ class Checks:
         print(f"{'ok  ' if condition else 'FAIL'} {name}" + ("" if condition else f": {detail}"))
 
 
+def refuse(message):
+    raise SystemExit(f"fem-tools course handin: {message}")
+
+
+def plain_name(name, what):
+    """A chapter's or a file's name as the hand-in gives it: one name, not a path."""
+    if not name or "/" in name or "\\" in name or ".." in name or name.startswith("."):
+        refuse(f"{what} '{name}' is not a plain name (no '/', no '..'): refused")
+    return name
+
+
+def links_in(folder):
+    """The symbolic links (dangling or not) and the entries that are neither regular files nor
+    folders under folder, the folder itself included."""
+    if folder.is_symlink():
+        return [folder]
+    found = []
+    for parent, dirs, files in os.walk(folder):
+        for name in dirs + files:
+            path = pathlib.Path(parent) / name
+            if path.is_symlink() or not (path.is_dir() or path.is_file()):
+                found.append(path)
+    return found
+
+
+def refuse_links(folder):
+    if found := links_in(folder):
+        refuse(f"the hand-in holds symbolic links or special files, which the check neither reads "
+               f"nor writes through: {', '.join(str(p) for p in found)}; hand in regular files")
+
+
+def read_bytes(path):
+    """A regular file's bytes, never through a link (O_NOFOLLOW: a link made after the scan)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
+    with os.fdopen(fd, "rb") as f:
+        return f.read()
+
+
 def source_hash(folder):
     """As chapters/registry.cmake computes it: SHA-256 of the lines "<file> <SHA-256>\\n" of the
     folder's .cpp and .hpp files, sorted by name."""
     files = sorted(p for p in folder.iterdir() if p.suffix in (".cpp", ".hpp"))
-    manifest = "".join(f"{p.name} {hashlib.sha256(p.read_bytes()).hexdigest()}\n" for p in files)
+    manifest = "".join(f"{p.name} {hashlib.sha256(read_bytes(p)).hexdigest()}\n" for p in files)
     return hashlib.sha256(manifest.encode()).hexdigest()
 
 
 def variants_of_run(run, root, wanted):
-    rows = {row["chapter"]: row for row in run["chapters"]}
+    rows = {plain_name(row["chapter"], "the run's chapter"): row for row in run["chapters"]}
+    for v in wanted:
+        plain_name(v, "--variant")
     if wanted:
         missing = [v for v in wanted if v not in rows]
         if missing:
             raise SystemExit(f"fem-tools course handin: the run measured no {', '.join(missing)} "
                              f"(it measured {', '.join(rows)})")
         return [rows[v] for v in wanted]
-    return [row for cid, row in rows.items() if (root / "chapters" / cid / "variant_of").exists()]
+    variants = [row for cid, row in rows.items() if (root / "chapters" / cid / "variant_of").exists()]
+    for row in variants:
+        refuse_links(root / "chapters" / row["chapter"])
+    return variants
 
 
 def check_sources(check, row, root):
@@ -71,9 +121,13 @@ def check_diff(check, row, root, folder):
     path = folder / f"{row['chapter']}.diff"
     if path.exists():
         check(f"{row['chapter']}: the diff handed in is the variant's change",
-              path.read_text() == text, f"{path} differs from ./tutorial.sh diff {row['chapter']}")
+              read_bytes(path).decode(errors="replace") == text,
+              f"{path} differs from ./tutorial.sh diff {row['chapter']}")
     else:
-        path.write_text(text)
+        # O_EXCL | O_NOFOLLOW: a new regular file, never through a link made after the scan.
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
         print(f"     {row['chapter']}: its change against its original written to {path}")
     check(f"{row['chapter']}: the variant changes something", text.strip() != "",
           "its diff against its original is empty")
@@ -112,9 +166,10 @@ def main(argv=None, prog=None):
     add_root_option(parser, hidden=True)
     args = parser.parse_args(argv)
     json_path = args.folder / "bench.json"
+    refuse_links(args.folder)
     if not json_path.is_file():
-        raise SystemExit(f"fem-tools course handin: no {json_path} (a hand-in is a run's folder)")
-    run = json.loads(json_path.read_text())
+        refuse(f"no {json_path} (a hand-in is a run's folder)")
+    run = json.loads(read_bytes(json_path))
     check = Checks()
     rows = variants_of_run(run, args.root, args.variant)
     check("the run measured a variant of a chapter", bool(rows),

@@ -15,6 +15,8 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from femtools.args import command_parser
 
+from femtools.files import replacing
+
 
 def data_array(text, name):
     match = re.search(rf'<DataArray[^>]*Name="{name}"[^>]*>(.*?)</DataArray>', text, re.S)
@@ -78,5 +80,6 @@ def main(argv=None, prog=None):
 
     anim = animation.FuncAnimation(fig, draw, frames=len(frames))
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    anim.save(args.out, writer=animation.PillowWriter(fps=args.fps))
+    with replacing(args.out) as tmp:
+        anim.save(tmp, writer=animation.PillowWriter(fps=args.fps))
     print(f"wrote {args.out} ({len(frames)} frames)")

@@ -5,6 +5,7 @@ import matplotlib.pyplot as plt
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 
+from femtools.files import replacing
 from femtools.results import poster
 from femtools.results.common import BASELINE, footer
 from femtools.results.phases import label
@@ -110,6 +111,7 @@ def plot(data, path):
              fontsize=6.5, color="0.35", ha="left", va="bottom", wrap=True)
     fig.tight_layout(rect=(0, 0.04, 1, 0.97))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=120)
     plt.close(fig)
     print(f"wrote {path}")

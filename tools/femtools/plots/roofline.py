@@ -16,6 +16,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from femtools.args import command_parser
+from femtools.files import replacing
 from femtools.results.phases import marker, parts
 
 # One marker per phase of the step (results/phases.py).
@@ -86,6 +87,7 @@ def main(argv=None, prog=None):
     legend(fig, chapters, colours, meshes)
     fig.tight_layout(rect=(0, 0, 1 - 2.0 / fig.get_figwidth(), 1))
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=130)
+    with replacing(args.out) as tmp:
+        fig.savefig(tmp, dpi=130)
     print(f"wrote {args.out}")
     return 0

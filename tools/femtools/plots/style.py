@@ -5,6 +5,7 @@ import textwrap
 import matplotlib
 import matplotlib.pyplot as plt
 
+from femtools.files import replacing
 from femtools.results.common import ResultsError, chapter_color, footer
 
 # Distinct colours for neighbouring aggregates (a greedy colouring needs only a few).
@@ -21,7 +22,8 @@ def finish(fig, data, path):
     if problems:
         plt.close(fig)
         raise ResultsError(f"{path.name}: the layout hides what it shows: " + "; ".join(problems))
-    fig.savefig(path, dpi=130)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")
 
@@ -79,6 +81,7 @@ def finish_figure(fig, path, note, top=0.95, left=0.0):
     lines = textwrap.wrap(note, int(16 * fig.get_figwidth()))  # about 16 characters an inch
     fig.text(0.01, 0.008, "\n".join(lines), fontsize=7.5, color="0.35")
     fig.tight_layout(rect=(left, (0.1 + 0.14 * len(lines)) / fig.get_figheight(), 1, top))
-    fig.savefig(path, dpi=130)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=130)
     plt.close(fig)
     print(f"wrote {path}")

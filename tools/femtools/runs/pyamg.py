@@ -24,6 +24,7 @@ from femtools.args import command_parser
 from femtools.docs.markdown import table
 from femtools.docs.markers import replace_between
 from femtools.paths import ROOT
+from femtools.files import write_text
 DEFAULT_MESHES = ["plate_poster", "beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
 
 
@@ -110,5 +111,5 @@ def main(argv=None, prog=None):
         record = {"schema_version": 1, "lesson": "pyamg", "chapter": "10_multigrid",
                   "readme": "chapters/10_multigrid/README.md", "marker": "pyamg-table",
                   "command": "fem-tools runs pyamg " + " ".join(sys.argv[1:] if argv is None else argv), "table": text}
-        pathlib.Path(args.json).write_text(json.dumps(record, indent=2) + "\n")
+        write_text(args.json, json.dumps(record, indent=2) + "\n")
         print(f"wrote {args.json}")

@@ -19,6 +19,7 @@ import tempfile
 import time
 
 from femtools.args import command_parser
+from femtools.files import write_text
 from femtools.paths import ROOT
 from femtools.results.common import BASELINE, ResultsError, die, load
 from femtools.results.regimes import HEADER_KEYS, chapter_names, iterations, share, speedup, validate_regimes
@@ -122,7 +123,7 @@ def main(argv=None, prog=None):
     else:
         data = sweep(args)
         args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(data, indent=1) + "\n")
+        write_text(args.out, json.dumps(data, indent=1) + "\n")
         print(f"wrote {args.out}")
         out_png = args.plot or args.out.with_name("regimes.png")
     problems = validate_regimes(data)

@@ -13,6 +13,7 @@ import time
 
 from femtools.args import command_parser
 from femtools.paths import ROOT
+from femtools.files import write_text
 COMMITTED = ["beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
 LARGE = ["beam_20k", "beam_50k", "beam_100k"]
 
@@ -93,5 +94,5 @@ def main(argv=None, prog=None):
               "uncommitted": header.get("uncommitted"), "budget_seconds": args.budget, "runs": runs, "skipped": skipped}
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(result, indent=1) + "\n")
+    write_text(out, json.dumps(result, indent=1) + "\n")
     print(f"wrote {out}")

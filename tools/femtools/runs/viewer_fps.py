@@ -17,6 +17,7 @@ import tempfile
 
 from femtools.args import command_parser
 from femtools.paths import ROOT
+from femtools.files import write_text
 
 PAUSED = "paused"
 
@@ -89,6 +90,6 @@ def main(argv=None, prog=None):
                   flush=True)
     out = pathlib.Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"schema_version": 1, "commit": git_commit(), "frames": args.frames,
+    write_text(out, json.dumps({"schema_version": 1, "commit": git_commit(), "frames": args.frames,
                                "runs": runs}, indent=2) + "\n")
     print(f"wrote {out}")
