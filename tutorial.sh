@@ -29,7 +29,7 @@ APT_PACKAGES=(
 )
 # What the other presets add: the clang preset builds with Clang and its OpenMP runtime (and
 # brings clang-format, which keeps the sources in .clang-format's style: CI checks it); the
-# catch2-3 preset unpacks Catch2 3 from bookworm-backports into build/ (scripts/catch2_3.sh,
+# catch2-3 preset unpacks Catch2 3 from bookworm-backports into build/ (tools/catch2_3.sh,
 # which installs nothing).
 case "$PRESET" in
   clang) APT_PACKAGES+=(clang clang-format libomp-dev) ;;
@@ -67,7 +67,7 @@ commands:
   regimes    build and run every chapter on both poster-sized bodies (the thin plate, the perforated
              bar) over a sweep of Young's modulus, with the solve table at each point (a few
              minutes on 2 cores): results/regimes.json and results/regimes.png; arguments go to
-             scripts/regimes.py (--help)
+             fem-tools runs regimes (--help)
   threads    build and measure chapter 09 (and 08 beside it) at 1, 2, ... up to every hardware
              thread on the poster-sized mesh: results/threads.json and results/threads.png
              (step and solve time against threads, with the ideal line)
@@ -79,11 +79,11 @@ commands:
   docs       commit the run in results/latest (or the folder given) (and results/*.json) as docs/data/*.json and regenerate the generated parts
              of the docs from it (tables in docs/results.md, the README and the chapter
              READMEs, plots in docs/images/; ctest -L docs checks they match), the lesson
-             tables (fem_lessons), the figures of chapters 10-12 (scripts/figures.py), the
-             chapter diffs (docs/diffs/) and the viewer's screenshot
+             tables (fem_lessons), the figures of chapters 10-12 (fem-tools plots figures), the
+             chapter diffs (docs/diffs/), the cantilever's animation (docs/images/cantilever.gif) and the viewer's screenshot
              (docs/images/viewer.png, headless); run bench first (scaling, viewer-bench, regimes
              too, for their tables: without their results the committed tables stay)
-  lessons    measure the lesson tables (fem_lessons, scripts/pyamg_reference.py; a few minutes),
+  lessons    measure the lesson tables (fem_lessons, fem-tools runs pyamg; a few minutes),
              record them in docs/data/lessons/*.json and write them into the chapter READMEs
              (ctest -L docs checks that the READMEs hold the recorded tables), and the data of
              the figures (fem_figure_data: docs/data/figures/*.json); part of docs
@@ -95,20 +95,24 @@ commands:
              --out DIR for another run folder, other arguments go to fem_lessons roofline
              (--chapters 12,12_mine, --meshes, --steps; fem_lessons roofline --help)
   sim        build and run the cantilever on the poster-sized mesh (VTK frames in out/sim/, open
-             out/sim/cantilever.pvd in ParaView) and render them to docs/images/cantilever.gif
+             out/sim/cantilever.pvd in ParaView) and render them to out/sim/cantilever.gif
+             (--out DIR for another folder; docs renders docs/images/cantilever.gif)
   viewer-bench
              build and measure the viewer's frame rate per chapter on the poster-sized mesh,
              headless (Xvfb): results/viewer.json, shown in the README by docs
   viewer     build and open the interactive viewer (fem_viewer --help for its options): drag the
              body with the mouse, switch chapters live; needs a display
   meshes     regenerate the committed meshes with gmsh (meshes/generate.py)
+  tools      the Python tooling of this tree: ./tutorial.sh tools GROUP COMMAND (results, docs,
+             plots, runs, course, check; ./tutorial.sh tools --help lists them), the same as
+             .venv/bin/fem-tools, which the set-up installs (tools/femtools)
   help       this text (also --help, -h)
 
 environment:
   PRESET=release|debug|asan|clang|catch2-3
                  which CMake preset to build and test with (default release; clang: compiled by
                  Clang; catch2-3: tested with Catch2 3, fetched into build/deps/ by
-                 scripts/catch2_3.sh; CMakePresets.json)
+                 tools/catch2_3.sh; CMakePresets.json)
   FEM_SKIP_PACKAGES=1
                  do not check or install system packages (for systems without apt-get, once
                  their packages are installed by hand: README, "Other systems")
@@ -166,22 +170,37 @@ install_system_packages() {
   fi
 }
 
+# Whether .venv's fem-tools imports: an editable install points at the tree that made it, which
+# may have been removed since (a second worktree sharing the .venv).
+tools_installed() {
+  (cd / && PYTHONPATH="" "$VENV/bin/python" -c "import femtools.cli" 2>/dev/null)
+}
+
 setup_venv() {
   local stamp="$VENV/.requirements.sha256"
   local want
-  want=$(sha256sum requirements.txt | cut -d' ' -f1)
-  if [ -x "$VENV/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then
+  want=$(cat requirements.txt tools/pyproject.toml | sha256sum | cut -d' ' -f1)
+  if [ -x "$VENV/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ] \
+    && tools_installed; then
     return 0
   fi
-  log "creating .venv and installing requirements.txt (gmsh, matplotlib)"
+  log "creating .venv and installing requirements.txt (gmsh, matplotlib) and tools/ (fem-tools)"
   [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
   "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r requirements.txt
+  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps -e tools/
   echo "$want" >"$stamp"
+}
+
+# The Python tooling, `fem-tools GROUP COMMAND` (tools/femtools; `./tutorial.sh tools --help`):
+# this tree's own package first on the path, whatever .venv has installed, so that a copy of the
+# repository (the coursework tests make them) or a second worktree runs its own tools.
+fem_tools() {
+  PYTHONPATH="$ROOT/tools${PYTHONPATH:+:$PYTHONPATH}" "$VENV/bin/python" -m femtools "$@"
 }
 
 configure() {
   if [ "$PRESET" = catch2-3 ]; then
-    scripts/catch2_3.sh >/dev/null
+    tools/catch2_3.sh >/dev/null
   fi
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     log "configuring (preset $PRESET)"
@@ -315,32 +334,32 @@ plots() {
   [ -f "$json" ] || { echo "tutorial.sh plots: no $json (usage: ./tutorial.sh plots DIR)" >&2; exit 2; }
   setup_python
   log "plotting $json into $out/"
-  "$VENV/bin/python" scripts/plot_results.py "$json" --out "$out"
+  fem_tools plots bench "$json" --out "$out"
 }
 
 compare() {
   [ $# -ge 1 ] && [ $# -le 2 ] || { echo "usage: ./tutorial.sh compare RUN [REFERENCE] (run folders or bench.json files)" >&2; exit 2; }
   setup_python
-  "$VENV/bin/python" scripts/compare_runs.py "$@"
+  fem_tools course compare "$@"
 }
 
 variant() {
   [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
   setup_python
-  "$VENV/bin/python" scripts/make_variant.py "$@"
+  fem_tools course variant "$@"
 }
 
-# A teacher's check of a hand-in (scripts/check_handin.py --help): the variant's sources against
+# A teacher's check of a hand-in (fem-tools course handin --help): the variant's sources against
 # the run's record, its diff, its tests, the plots regenerated from the JSON.
 handin_check() {
   [ $# -ge 1 ] || { echo "usage: ./tutorial.sh handin-check FOLDER [--variant NN_NAME] (a run's folder handed in)" >&2; exit 2; }
   build
-  "$VENV/bin/python" scripts/check_handin.py --build "$BUILD_DIR" "$@"
+  fem_tools course handin --build "$BUILD_DIR" "$@"
 }
 
 diff_variant() {
   [ $# -eq 1 ] || { echo "usage: ./tutorial.sh diff VARIANT (its name, e.g. my_fused_updates, or its folder 06_my_fused_updates)" >&2; exit 2; }
-  python3 scripts/chapter_diffs.py --variant "$1"
+  fem_tools docs diffs --variant "$1"
 }
 
 threads() {
@@ -351,25 +370,25 @@ threads() {
   log "chapter 09 at $counts threads (chapter 08 beside it, one thread) on the poster-sized mesh"
   "$BUILD_DIR/fem_bench" --chapters 08,09 --threads "$counts" --no-solvers \
     --json results/threads.json --replace "$@"
-  "$VENV/bin/python" scripts/plot_results.py --threads results/threads.json --out results
+  fem_tools plots bench --threads results/threads.json --out results
 }
 
 scaling() {
   quiet_build
   log "scaling over the beam series (a time budget per run; --help for the options)"
-  "$VENV/bin/python" scripts/scaling.py --bench "$BUILD_DIR/fem_bench" --out results/scaling.json "$@"
-  "$VENV/bin/python" scripts/plot_results.py --scaling results/scaling.json --out results
+  fem_tools runs scaling --bench "$BUILD_DIR/fem_bench" --out results/scaling.json "$@"
+  fem_tools plots bench --scaling results/scaling.json --out results
 }
 
 regimes() {
   build
-  log "the regime sweep: every chapter, both poster-sized bodies, E over decades (scripts/regimes.py --help)"
-  "$VENV/bin/python" scripts/regimes.py --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
+  log "the regime sweep: every chapter, both poster-sized bodies, E over decades (fem-tools runs regimes --help)"
+  fem_tools runs regimes --bench "$BUILD_DIR/fem_bench" --out results/regimes.json "$@"
 }
 
 lessons() {
   quiet_build
-  log "lesson tables (fem_lessons, scripts/pyamg_reference.py: a few minutes), recorded in docs/data/lessons/"
+  log "lesson tables (fem_lessons, fem-tools runs pyamg: a few minutes), recorded in docs/data/lessons/"
   mkdir -p docs/data/lessons
   local lesson
   for lesson in noalias dfdx-fill compose spmv rotations threads-element; do
@@ -378,7 +397,7 @@ lessons() {
   "$BUILD_DIR/fem_lessons" multigrid --steps 100 --threads 1 --cost-threads 1,2 --json docs/data/lessons/multigrid.json >/dev/null
   # Chapter 11: gmsh's own orders beside the chapter's, on the plate, beam_10k and (when
   # `./tutorial.sh meshes --large` made it) the 82k-node beam.
-  "$VENV/bin/python" scripts/renumber_meshes.py >/dev/null
+  fem_tools runs renumber-meshes >/dev/null
   local large=""
   [ -f meshes/generated/beam_100k.msh ] && large=",meshes/generated/beam_100k.msh"
   "$BUILD_DIR/fem_lessons" node-order --steps 10 --meshes "meshes/beam_10k.msh$large" \
@@ -388,7 +407,7 @@ lessons() {
     --json docs/data/lessons/half-the-bytes.json >/dev/null
   "$BUILD_DIR/fem_lessons" batched-elements --steps 20 --meshes "meshes/beam_10k.msh$large" \
     --json docs/data/lessons/batched-elements.json >/dev/null
-  "$VENV/bin/python" scripts/pyamg_reference.py --tool "$BUILD_DIR/fem_lessons" \
+  fem_tools runs pyamg --tool "$BUILD_DIR/fem_lessons" \
     --json docs/data/lessons/pyamg.json >/dev/null
   # The course's closing page: the roofs and every chapter on the plate, the last chapter on
   # the 82k-node beam too when it was generated (docs/roofline.md, docs/images/roofline.png).
@@ -396,9 +415,9 @@ lessons() {
   [ -f meshes/generated/beam_100k.msh ] && beam="meshes/generated/beam_100k.msh"
   "$BUILD_DIR/fem_lessons" roofline --steps 20 --meshes "$beam" \
     --json docs/data/lessons/roofline.json >/dev/null
-  "$VENV/bin/python" scripts/plot_roofline.py docs/data/lessons/roofline.json --out docs/images/roofline.png
-  "$VENV/bin/python" scripts/lesson_tables.py
-  # The code's own data behind the figures of chapters 10 and 11 (scripts/figures.py draws them).
+  fem_tools plots roofline docs/data/lessons/roofline.json --out docs/images/roofline.png
+  fem_tools docs lessons
+  # The code's own data behind the figures of chapters 10 and 11 (fem-tools plots figures draws them).
   mkdir -p docs/data/figures
   "$BUILD_DIR/fem_figure_data" hierarchy --mesh meshes/plate_poster.msh \
     --json docs/data/figures/hierarchy.json
@@ -414,7 +433,7 @@ roofline() {
   mkdir -p "$out"
   log "the roofline: this machine's roofs and every chapter's phases under them, into $out/"
   "$BUILD_DIR/fem_lessons" roofline --steps 100 --json "$out/roofline.json" "$@"
-  "$VENV/bin/python" scripts/plot_roofline.py "$out/roofline.json" --out "$out/roofline.png"
+  fem_tools plots roofline "$out/roofline.json" --out "$out/roofline.png"
 }
 
 docs() {
@@ -428,19 +447,22 @@ docs() {
   for json in scaling viewer regimes threads; do
     if [ -f "results/$json.json" ]; then cp "results/$json.json" "docs/data/$json.json"; fi
   done
-  "$VENV/bin/python" scripts/plot_results.py docs/data/bench.json --out docs/images
+  fem_tools plots bench docs/data/bench.json --out docs/images
   if [ -f docs/data/scaling.json ]; then
-    "$VENV/bin/python" scripts/plot_results.py --scaling docs/data/scaling.json --out docs/images
+    fem_tools plots bench --scaling docs/data/scaling.json --out docs/images
   fi
   if [ -f docs/data/threads.json ]; then
-    "$VENV/bin/python" scripts/plot_results.py --threads docs/data/threads.json --out docs/images
+    fem_tools plots bench --threads docs/data/threads.json --out docs/images
   fi
   if [ -f results/regimes.png ]; then cp results/regimes.png docs/images/regimes.png; fi
-  log "figures of chapters 10-12 (scripts/figures.py, from docs/data/figures/ and the code)"
-  "$VENV/bin/python" scripts/figures.py --out docs/images
-  "$VENV/bin/python" scripts/update_docs.py
+  log "figures of chapters 10-12 (fem-tools plots figures, from docs/data/figures/ and the code)"
+  fem_tools plots figures --out docs/images
+  fem_tools docs update
   log "chapter diffs (docs/diffs/)"
-  "$VENV/bin/python" scripts/chapter_diffs.py
+  fem_tools docs diffs
+  log "the cantilever's animation (docs/images/cantilever.gif, from ./tutorial.sh sim's run)"
+  sim --out out/docs_sim >/dev/null
+  cp out/docs_sim/cantilever.gif docs/images/cantilever.gif
   if [ -x "$BUILD_DIR/fem_viewer" ] && command -v xvfb-run >/dev/null; then
     log "viewer screenshot (headless, Xvfb): docs/images/viewer.png"
     xvfb-run -a -s "-screen 0 1280x800x24" "$BUILD_DIR/fem_viewer" --frames 90 \
@@ -448,14 +470,20 @@ docs() {
   fi
 }
 
+# The run's folder gets the frames and the gif: a tracked file (docs/images/cantilever.gif) is
+# written only by ./tutorial.sh docs, which exists to regenerate the docs.
 sim() {
+  local out=out/sim args=("$@") i
+  for ((i = 0; i < ${#args[@]}; i++)); do
+    [ "${args[i]}" = --out ] && out="${args[i + 1]:-}"
+  done
   quiet_build
-  log "simulating the cantilever on the poster-sized mesh (VTK frames in out/sim/)"
-  "$BUILD_DIR/fem_sim" --out out/sim --every 4 "$@"
-  log "rendering the frames to docs/images/cantilever.gif"
+  log "simulating (VTK frames in $out/)"
+  "$BUILD_DIR/fem_sim" --out "$out" --every 4 "$@"
   local pvd
-  pvd=$(ls -t out/sim/*.pvd | head -n 1)
-  "$VENV/bin/python" scripts/render_gif.py "$pvd" --out docs/images/cantilever.gif
+  pvd=$(ls -t "$out"/*.pvd | head -n 1)
+  log "rendering the frames to ${pvd%.pvd}.gif"
+  fem_tools plots gif "$pvd" --out "${pvd%.pvd}.gif"
 }
 
 viewer() {
@@ -469,11 +497,11 @@ viewer_bench() {
   quiet_build
   [ -x "$BUILD_DIR/fem_viewer" ] || { echo "fem_viewer was not built (see the CMake warning)" >&2; exit 1; }
   log "the viewer's frame rate per chapter, headless (Xvfb, Mesa's software OpenGL)"
-  "$VENV/bin/python" scripts/viewer_fps.py --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"
+  fem_tools runs viewer-fps --viewer "$BUILD_DIR/fem_viewer" --out results/viewer.json "$@"
 }
 
 # The book: every measurement the docs show, recorded on this machine in one sitting, then the
-# docs regenerated from it and docs/data/book.json written (scripts/book.py: the sources each
+# docs regenerated from it and docs/data/book.json written (fem-tools docs book: the sources each
 # chapter's data come from; ctest -L docs fails once a chapter's code differs from them).
 book_quiet_check() {
   local load cores
@@ -512,7 +540,7 @@ book() {
                              [viewer]=120 [docs]=900)
   local name seconds
   while read -r name seconds; do BOOK_ESTIMATE[$name]=$seconds; done \
-    < <("$VENV/bin/python" scripts/book.py estimate)
+    < <(fem_tools docs book estimate)
   BOOK_STAGE=0 BOOK_START=$SECONDS BOOK_TIMES=()
   local started
   started=$(date +%s)
@@ -525,7 +553,7 @@ book() {
   book_stage viewer viewer_bench
   book_stage docs docs results/book
   local IFS=,
-  "$VENV/bin/python" scripts/book.py manifest --started "$started" --stages "${BOOK_TIMES[*]}"
+  fem_tools docs book manifest --started "$started" --stages "${BOOK_TIMES[*]}"
   log "book: recorded in $(((SECONDS - BOOK_START) / 60)) min; commit docs/ (git status docs)"
 }
 
@@ -558,6 +586,7 @@ main() {
     viewer) viewer "$@" ;;
     viewer-bench) viewer_bench "$@" ;;
     meshes) meshes "$@" ;;
+    tools) setup_python; fem_tools "$@" ;;
     help | --help | -h) usage ;;
     *)
       echo "tutorial.sh: unknown command '$cmd'" >&2

@@ -1,8 +1,7 @@
 // fem_figure_data: the code's own data behind the figures a table cannot show, as JSON for
-// scripts/figures.py (docs/data/figures/): chapter 10's hierarchy (level sizes and the
+// fem-tools plots figures (docs/data/figures/): chapter 10's hierarchy (level sizes and the
 // aggregate of every node) and chapter 11's node orders. The figures read the mesh file
 // themselves; the tet checksum lets them check that they number its nodes as load_mesh does.
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -10,6 +9,7 @@
 #include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/node_order.hpp"
+#include "common/atomic_file.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
 
@@ -98,15 +98,16 @@ int main(int argc, char** argv) {
     args.option("json", "FILE", "where to write the JSON", "");
     if (!args.parse(argc - 1, argv + 1)) return 0;
     if (args.get("json").empty()) throw UsageError("--json FILE is required");
+    apply_thread_environment();
     const Scene scene = scene_from_args(args);
-    std::ofstream out(args.get("json"));
-    if (!out) throw std::runtime_error("cannot write '" + args.get("json") + "'");
-    out << "{\n" << mesh_record(args, scene) << "  \"figure\": " << json_string(what) << ",\n";
-    if (what == "hierarchy")
-      hierarchy(out, scene);
-    else
-      node_orders(out, scene);
-    out << "}\n";
+    write_file_atomically(args.get("json"), [&](std::ostream& out) {
+      out << "{\n" << mesh_record(args, scene) << "  \"figure\": " << json_string(what) << ",\n";
+      if (what == "hierarchy")
+        hierarchy(out, scene);
+      else
+        node_orders(out, scene);
+      out << "}\n";
+    });
     return 0;
   });
 }

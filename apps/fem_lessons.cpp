@@ -6,13 +6,14 @@
 // course, not of one chapter (the roofline, apps/roofline/), is registered here.
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "apps/roofline/lesson.hpp"
 #include "chapters/registry.hpp"
+#include "common/atomic_file.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
 #include "common/lesson.hpp"
@@ -64,13 +65,12 @@ std::string command_line(int argc, char** argv) {
   return out;
 }
 
-// The table as committed data (docs/data/lessons/NAME.json): scripts/lesson_tables.py writes
+// The table as committed data (docs/data/lessons/NAME.json): fem-tools docs lessons writes
 // it between the lesson's markers of the chapter's README (or the lesson's own page), and
 // checks that it is there. A lesson's numbers, when it leaves them, go in "data".
 void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo* chapter,
                 const std::string& command, const std::string& table, const std::string& data) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  std::ostringstream out;
   const std::string id = chapter ? chapter->id : "";
   const std::string readme =
       !lesson.readme.empty() ? lesson.readme : "chapters/" + id + "/README.md";
@@ -81,15 +81,16 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
       << ",\n  \"machine\": {" << machine_record_json(machine_record()) << "}";
   if (!data.empty()) out << ",\n  \"data\": " << data;
   out << "\n}\n";
+  write_file_atomically(path, out.str());
 }
 
 // Fails before the work when the JSON cannot be written there.
-void check_writable(const std::string& path) {
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir))
-    throw UsageError("--json " + path + ": no directory " + dir.string());
-  if (!std::ofstream(path, std::ios::app))
-    throw UsageError("--json " + path + ": cannot write there");
+void check_json_writable(const std::string& path) {
+  try {
+    check_writable(path);
+  } catch (const WriteError& e) {
+    throw UsageError(std::string("--json: ") + e.what());
+  }
 }
 
 // The lesson's table, on one thread unless the lesson measures threads; a run on a busy
@@ -137,7 +138,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
     const std::string& json = args.get("json");
     if ((!readme.empty() || !json.empty()) && runs.size() > 1)
       throw UsageError("--readme and --json record the course's table: leave --chapter out");
-    if (!json.empty()) check_writable(json);
+    if (!json.empty()) check_json_writable(json);
     // A lesson may leave std::fixed and a precision on the streams: the next run (a
     // variant's, after the original's) starts from the streams' defaults again.
     std::ios cout_defaults(nullptr), cerr_defaults(nullptr);

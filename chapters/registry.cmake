@@ -53,7 +53,7 @@ function(fem_fail dir message)
   message(FATAL_ERROR "chapters/${dir}: ${message} (the convention: chapters/README.md)")
 endfunction()
 
-# The hash of a chapter's sources, as scripts/check_handin.py computes it: SHA-256 of the
+# The hash of a chapter's sources, as fem-tools course handin computes it: SHA-256 of the
 # lines "<file> <SHA-256 of the file>\n" of its .cpp and .hpp files, sorted by name.
 function(fem_source_hash out dir)
   file(GLOB sources RELATIVE ${SOURCE_DIR}/chapters/${dir} ${SOURCE_DIR}/chapters/${dir}/*.cpp

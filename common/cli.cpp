@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
 
@@ -112,6 +113,8 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
+const char* help_notice = nullptr;  // constant-initialized: set before any use
+
 std::string ArgParser::help() const {
   std::ostringstream out;
   out << "usage: " << program_ << " [options]\n\n" << summary_ << "\n\noptions:\n";
@@ -123,6 +126,7 @@ std::string ArgParser::help() const {
     out << "\n";
   }
   out << "  --help                  print this help and exit\n";
+  if (help_notice) out << "\n" << help_notice << "\n";
   return out.str();
 }
 
@@ -207,6 +211,15 @@ void add_thread_option(ArgParser& args) {
               "");
 }
 
+void apply_thread_environment() {
+  try {
+    if (const std::string warning = check_thread_environment(); !warning.empty())
+      std::cerr << "warning: " << warning << "\n";
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 int threads_from_args(const ArgParser& args) {
   if (const std::string& value = args.get("threads"); !value.empty()) {
     const int n = args.get_int("threads");
@@ -217,6 +230,8 @@ int threads_from_args(const ArgParser& args) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--threads: ") + e.what());
     }
+  } else {
+    apply_thread_environment();
   }
   return max_threads();
 }
@@ -233,7 +248,22 @@ void write_between_markers(const std::string& path, const std::string& name,
   if (b == std::string::npos || e == std::string::npos || e < b)
     throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
   doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
-  std::ofstream(path) << doc;
+  write_file_atomically(path, doc);
+}
+
+void announce_long_run(const std::string& program, double seconds_per_step, long long steps) {
+  const double seconds = seconds_per_step * static_cast<double>(steps);
+  if (!(seconds > 60.0)) return;
+  std::ostringstream about;
+  about.precision(seconds < 600.0 ? 1 : 0);
+  about << std::fixed;
+  if (seconds < 3600.0)
+    about << seconds / 60.0 << " min";
+  else
+    about << seconds / 3600.0 << " h";
+  std::cout << program << ": this run will take about " << about.str() << " (" << steps
+            << " steps at " << format_number(seconds_per_step) << " s each, from the first)"
+            << std::endl;
 }
 
 int run_program(const std::string& program, const std::function<int()>& body) {

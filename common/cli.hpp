@@ -22,6 +22,10 @@ struct UsageError : std::runtime_error {
 std::optional<int> parse_int(const std::string& s);
 std::optional<double> parse_double(const std::string& s);
 
+// The last line of every program's --help, or nullptr: the gmsh reader (common/mesh_gmsh.cpp)
+// sets it, so that a program that links the gmsh SDK says so and under which license.
+extern const char* help_notice;
+
 class ArgParser {
  public:
   ArgParser(std::string program, std::string summary);
@@ -66,6 +70,15 @@ void add_thread_option(ArgParser& args);
 // count below 1, above 1 in a build without OpenMP, or above thread_limit() (common/threads.hpp);
 // warns on stderr above the hardware threads.
 int threads_from_args(const ArgParser& args);
+// Without --threads: OMP_NUM_THREADS checked by the same rule (check_thread_environment):
+// throws UsageError above the limit, warns on stderr above the hardware threads.
+void apply_thread_environment();
+
+// A run that will take longer than a minute says so before it goes on, from its first timed
+// step: "<program>: this run will take about 7 min (N steps at 0.42 s each)". Prints nothing
+// for a shorter one. Flushed, as every progress line is, so that it reaches a file as it
+// reaches a terminal.
+void announce_long_run(const std::string& program, double seconds_per_step, long long steps);
 
 // main()'s error handling, written once: returns body()'s exit status; a UsageError prints
 // "<program>: <why> (see <program> --help)" and returns 2, any other exception

@@ -1,6 +1,7 @@
 #include "common/threads.hpp"
 
 #include <Eigen/Core>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "common/build_info.hpp"
@@ -61,6 +62,22 @@ std::string check_thread_count(int n) {
            "for each other at every barrier (expect it slower than " +
            std::to_string(hardware) + ")";
   return "";
+}
+
+std::string check_thread_environment() {
+  const char* value = std::getenv("OMP_NUM_THREADS");
+  if (!value) return "";
+  char* end = nullptr;
+  const long n = std::strtol(value, &end, 10);  // "4,2" (nested levels): the outer count
+  if (end == value || n < 1 || n > 1 << 20) return "";
+  const std::string name = std::string("OMP_NUM_THREADS=") + value;
+  try {
+    const std::string warning = check_thread_count(static_cast<int>(n));
+    return warning.empty() ? "" : name + ": " + warning;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(name + ": " + e.what() +
+                                "; unset it, or give --threads N (which overrides it)");
+  }
 }
 
 OneThreadScope::OneThreadScope() : openmp_(max_threads()), eigen_(Eigen::nbThreads()) {

@@ -37,6 +37,12 @@ int thread_limit();
 // warning to print when n is more than the hardware threads (oversubscribed), else "".
 std::string check_thread_count(int n);
 
+// The same check of the count the environment asks for (OMP_NUM_THREADS, its first number),
+// which every program without --threads runs on: throws std::invalid_argument naming the
+// variable above thread_limit(), returns the warning above the hardware threads, "" when the
+// variable is unset (or not a count, which OpenMP ignores too).
+std::string check_thread_environment();
+
 // Sets the thread count for a scope and restores the previous one: tests, benchmarks.
 class ThreadCountScope {
  public:

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "common/atomic_file.hpp"
+
 namespace fem {
 namespace {
 
@@ -15,11 +17,37 @@ std::string frame_file(const std::string& name, int frame) {
   return name + buf;
 }
 
-std::ofstream open_or_throw(const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
+// One frame: the deformed tetrahedra, with the displacement and the velocity at the nodes.
+void write_vtu(std::ostream& out, const Eigen::Matrix3Xd& rest,
+               const std::vector<Eigen::Vector4i>& tets, const Eigen::VectorXd& x,
+               const Eigen::VectorXd& v) {
+  const Eigen::Index n = rest.cols();
   out.precision(9);
-  return out;
+  out << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << tets.size()
+      << "\">\n<Points>\n"
+      << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (Eigen::Index i = 0; i < n; ++i)
+    out << x[3 * i] << ' ' << x[3 * i + 1] << ' ' << x[3 * i + 2] << '\n';
+  out << "</DataArray>\n</Points>\n<Cells>\n"
+      << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
+  for (const auto& t : tets) out << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+  out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < tets.size(); ++e) out << 4 * (e + 1) << '\n';
+  out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+  for (std::size_t e = 0; e < tets.size(); ++e) out << "10\n";  // VTK_TETRA
+  out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n"
+      << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
+         "format=\"ascii\">\n";
+  for (Eigen::Index i = 0; i < n; ++i)
+    out << x[3 * i] - rest(0, i) << ' ' << x[3 * i + 1] - rest(1, i) << ' '
+        << x[3 * i + 2] - rest(2, i) << '\n';
+  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" "
+         "NumberOfComponents=\"3\" format=\"ascii\">\n";
+  for (Eigen::Index i = 0; i < n; ++i)
+    out << v[3 * i] << ' ' << v[3 * i + 1] << ' ' << v[3 * i + 2] << '\n';
+  out << "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
 }
 
 // name_NNNNNN.vtu: a frame of the series `name` (not of another series in the same folder).
@@ -78,44 +106,18 @@ std::string VtkSeries::pvd_path() const {
 void VtkSeries::write_frame(double time, const Eigen::Matrix3Xd& rest,
                             const std::vector<Eigen::Vector4i>& tets, const Eigen::VectorXd& x,
                             const Eigen::VectorXd& v) {
-  const Eigen::Index n = rest.cols();
   const std::string file = frame_file(name_, frames());
-  {
-    std::ofstream out = open_or_throw(std::filesystem::path(directory_) / file);
-    out << "<?xml version=\"1.0\"?>\n"
-        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-        << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\""
-        << tets.size() << "\">\n<Points>\n"
-        << "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (Eigen::Index i = 0; i < n; ++i)
-      out << x[3 * i] << ' ' << x[3 * i + 1] << ' ' << x[3 * i + 2] << '\n';
-    out << "</DataArray>\n</Points>\n<Cells>\n"
-        << "<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : tets) out << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t e = 0; e < tets.size(); ++e) out << 4 * (e + 1) << '\n';
-    out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t e = 0; e < tets.size(); ++e) out << "10\n";  // VTK_TETRA
-    out << "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n"
-        << "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" "
-           "format=\"ascii\">\n";
-    for (Eigen::Index i = 0; i < n; ++i)
-      out << x[3 * i] - rest(0, i) << ' ' << x[3 * i + 1] - rest(1, i) << ' '
-          << x[3 * i + 2] - rest(2, i) << '\n';
-    out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" "
-           "NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (Eigen::Index i = 0; i < n; ++i)
-      out << v[3 * i] << ' ' << v[3 * i + 1] << ' ' << v[3 * i + 2] << '\n';
-    out << "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    if (!out) throw std::runtime_error("cannot write '" + file + "'");
-  }
+  write_file_atomically((std::filesystem::path(directory_) / file).string(),
+                        [&](std::ostream& out) { write_vtu(out, rest, tets, x, v); });
   times_.push_back(time);
-  std::ofstream pvd = open_or_throw(pvd_path());
-  pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
-  for (int f = 0; f < frames(); ++f)
-    pvd << "<DataSet timestep=\"" << times_[f] << "\" part=\"0\" file=\"" << frame_file(name_, f)
-        << "\"/>\n";
-  pvd << "</Collection>\n</VTKFile>\n";
+  write_file_atomically(pvd_path(), [&](std::ostream& pvd) {
+    pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
+        << "<Collection>\n";
+    for (int f = 0; f < frames(); ++f)
+      pvd << "<DataSet timestep=\"" << times_[f] << "\" part=\"0\" file=\"" << frame_file(name_, f)
+          << "\"/>\n";
+    pvd << "</Collection>\n</VTKFile>\n";
+  });
 }
 
 }  // namespace fem

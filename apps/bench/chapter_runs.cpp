@@ -1,10 +1,12 @@
 #include "apps/bench/chapter_runs.hpp"
 
+#include <chrono>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 
 #include "common/alloc_counter.hpp"
+#include "common/cli.hpp"
 #include "common/threads.hpp"
 
 namespace fem::bench {
@@ -92,7 +94,14 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                                         const Schedule& schedule) {
   std::vector<ChapterRun> runs = make_runs(chapters, scene, solver, thread_counts);
   for (int k = 0; k < schedule.total(); ++k) {
+    const auto start = std::chrono::steady_clock::now();
     for (ChapterRun& run : runs) step(run, k, schedule.measured(k));
+    // The first round allocates the steppers' buffers: the estimate is taken from the second.
+    if (k == 1)
+      announce_long_run(
+          "fem_bench",
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+          schedule.total());
     if (schedule.reports(k))
       std::cout << "  step " << k + 1 << "/" << schedule.total() << " of every chapter\n"
                 << std::flush;

@@ -6,6 +6,7 @@
 // results' folder); the order statistics are common/statistics.hpp's.
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "apps/bench/chapter_runs.hpp"
 #include "apps/bench/options.hpp"
@@ -31,14 +32,17 @@ std::vector<SolverResult> solve_tables(const Scene& scene, const BenchOptions& o
 
 int run_bench(const ArgParser& args) {
   const BenchOptions options = bench_options(args);
-  // The scene before the folder: a bad mesh or material leaves no empty run folder behind.
+  // The folder is this run's before any work: a second run into it is refused, naming this one.
+  const std::optional<RunLock> lock = lock_run_folder(options);
+  const bool replacing = !options.json.empty() && std::filesystem::exists(options.json);
+  if (replacing && !options.replace) throw UsageError(holds_a_run(options.json));
   const Scene scene = scene_from_args(args);
   if (!options.json.empty()) check_writable(options.json);
   const SourceState source = source_state();
   print_setup(scene, options, source);
   LoadMonitor load;
   std::cout << "running " << options.chapters.size()
-            << " chapters interleaved, one step each in turn\n";
+            << " chapters interleaved, one step each in turn" << std::endl;
   const std::vector<ChapterResult> results = run_chapters(options.chapters, scene, options.solver,
                                                           options.thread_counts, options.schedule);
   print_chapters(results);
@@ -46,12 +50,12 @@ int run_bench(const ArgParser& args) {
       options.solve_tables ? solve_tables(scene, options) : std::vector<SolverResult>{};
   load.stop();
   if (const std::string& path = options.json; !path.empty()) {
-    const bool replaced = std::filesystem::exists(path);
-    const int removed = options.json_named ? 0 : remove_previous_plots(path);
     write_json(path, scene, options, results, solvers, load, source);
+    // The plots after the JSON: a failed write leaves the earlier run whole, plots and all.
+    const int removed = options.json_named ? 0 : remove_previous_plots(path);
     std::cout << "\nwrote " << path
-              << (replaced ? " (--replace: replacing the run that was there" : "")
-              << (replaced && removed ? ", and its plots" : "") << (replaced ? ")" : "") << "\n";
+              << (replacing ? " (--replace: replaced the run that was there" : "")
+              << (replacing && removed ? ", and its plots" : "") << (replacing ? ")" : "") << "\n";
     if (!options.latest.empty()) point_latest_at(options.latest);
   }
   if (const std::string warning = load.warning(); !warning.empty()) std::cerr << warning << "\n";

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/bench/run_folder.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
 
@@ -16,6 +17,7 @@ namespace {
 // "1,2,4" -> {1, 2, 4}; empty -> 1 and OpenMP's count (OMP_NUM_THREADS or every core).
 std::vector<int> parse_thread_counts(const std::string& list) {
   if (list.empty()) {
+    apply_thread_environment();
     std::vector<int> out = {1};
     if (max_threads() > 1) out.push_back(max_threads());
     return out;
@@ -112,7 +114,7 @@ void add_bench_options(ArgParser& args) {
   args.option("out", "DIR",
               "the run's folder: writes DIR/bench.json (default: a new folder "
               "results/run-DATE-TIME, and results/latest points to it); a folder that holds a "
-              "run is refused unless --replace",
+              "run is refused unless --replace, a folder another run is writing always",
               "");
   args.flag("replace", "replace the run (bench.json and its plots) in --out DIR or at --json FILE");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
@@ -137,9 +139,7 @@ BenchOptions bench_options(const ArgParser& args) {
   if (!o.json.empty() && !o.json_named && args.get("out").empty())
     o.latest = std::filesystem::path(o.json).parent_path().filename().string();
   if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))
-    throw UsageError("'" + o.json +
-                     "' holds an earlier run: give another --out (or --json), or --replace to "
-                     "replace it and its plots");
+    throw UsageError(holds_a_run(o.json));
   o.solve_tables = !args.has_flag("no-solvers");
   return o;
 }

@@ -1,10 +1,10 @@
 #include "apps/bench/report_json.hpp"
 
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 
+#include "common/atomic_file.hpp"
 #include "common/json.hpp"
 #include "common/machine_record.hpp"
 #include "common/threads.hpp"
@@ -82,13 +82,10 @@ void write_solver(std::ostream& out, const SolverResult& s) {
       << ", \"allocations_per_solve\": " << s.allocations_per_solve << "}";
 }
 
-}  // namespace
-
-void write_json(const std::string& path, const Scene& scene, const BenchOptions& options,
-                const std::vector<ChapterResult>& results, const std::vector<SolverResult>& solvers,
-                const LoadMonitor& load, const SourceState& source) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+void write_document(std::ostream& out, const Scene& scene, const BenchOptions& options,
+                    const std::vector<ChapterResult>& results,
+                    const std::vector<SolverResult>& solvers, const LoadMonitor& load,
+                    const SourceState& source) {
   out << std::setprecision(10);
   out << "{\n  \"schema_version\": 1,\n";
   write_run(out, scene, options, load, source);
@@ -107,6 +104,16 @@ void write_json(const std::string& path, const Scene& scene, const BenchOptions&
     out << "  ]";
   }
   out << "\n}\n";
+}
+
+}  // namespace
+
+void write_json(const std::string& path, const Scene& scene, const BenchOptions& options,
+                const std::vector<ChapterResult>& results, const std::vector<SolverResult>& solvers,
+                const LoadMonitor& load, const SourceState& source) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    write_document(out, scene, options, results, solvers, load, source);
+  });
 }
 
 }  // namespace fem::bench

@@ -1,4 +1,4 @@
-// The run as JSON (the schema in README.md, checked by scripts/validate_bench.py): what was
+// The run as JSON (the schema in README.md, checked by fem-tools results validate): what was
 // measured, on what, and the chapter and solve tables.
 #pragma once
 

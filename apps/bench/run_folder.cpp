@@ -27,6 +27,33 @@ void check_writable(const std::string& path) {
   if (!existed) fs::remove(file, error);
 }
 
+std::optional<RunLock> lock_run_folder(const BenchOptions& options) {
+  std::optional<RunLock> lock;
+  if (options.json.empty()) return lock;
+  const fs::path json(options.json);
+  const std::string folder = json.parent_path().empty() ? "." : json.parent_path().string();
+  try {
+    if (options.json_named)
+      lock.emplace(folder, "fem_bench", "." + json.filename().string() + ".lock");
+    else
+      lock.emplace(folder, "fem_bench");
+  } catch (const FolderInUse& e) {
+    throw UsageError(e.what());
+  } catch (const std::runtime_error& e) {
+    throw UsageError(std::string("cannot write the results: ") + e.what());
+  }
+  if (lock->stale_pid() > 0)
+    std::cout << "note: " << folder << " held the lock of a run that is gone (pid "
+              << lock->stale_pid() << "); taken over\n";
+  return lock;
+}
+
+std::string holds_a_run(const std::string& json) {
+  return "'" + json +
+         "' holds an earlier run: give another --out (or --json), or --replace to replace it "
+         "and its plots";
+}
+
 void point_latest_at(const std::string& folder) {
   const fs::path link = fs::path("results") / "latest";
   std::error_code error;
@@ -40,7 +67,7 @@ void point_latest_at(const std::string& folder) {
 }
 
 int remove_previous_plots(const std::string& json) {
-  // The plots scripts/plot_results.py makes of a run.
+  // The plots fem-tools plots bench makes of a run.
   constexpr std::array<const char*, 5> kRunPlots = {
       "phases.png", "phases_stacked.png", "speedup.png", "allocations.png", "solvers.png"};
   int removed = 0;

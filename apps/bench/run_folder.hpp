@@ -1,8 +1,12 @@
 // A run is a folder: its bench.json and the plots ./tutorial.sh bench makes of it
-// (scripts/plot_results.py). The housekeeping around the JSON file.
+// (fem-tools plots bench). The housekeeping around the JSON file.
 #pragma once
 
+#include <optional>
 #include <string>
+
+#include "apps/bench/options.hpp"
+#include "common/run_lock.hpp"
 
 namespace fem::bench {
 
@@ -10,6 +14,15 @@ namespace fem::bench {
 // that a run of minutes does not end in "cannot write". An existing file is left as it is
 // until the run is over; a probe file that did not exist is removed again. Throws UsageError.
 void check_writable(const std::string& path);
+
+// The run's lock (common/run_lock.hpp): on its folder (--out DIR, or the new folder), or on
+// the JSON file's own name beside it for --json FILE (a folder such as results/ holds several
+// such files, each another program's). None without JSON. Throws UsageError naming the run
+// that holds it.
+std::optional<RunLock> lock_run_folder(const BenchOptions& options);
+
+// "'PATH' holds an earlier run: ...": the refusal without --replace.
+std::string holds_a_run(const std::string& json);
 
 // results/latest -> results/FOLDER (a relative symbolic link), the convention for "the newest
 // run"; a warning, not an error, where the file system has no links.

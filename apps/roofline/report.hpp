@@ -1,4 +1,4 @@
-// The roofline lesson's tables (Markdown) and its data (JSON, for scripts/plot_roofline.py).
+// The roofline lesson's tables (Markdown) and its data (JSON, for fem-tools plots roofline).
 #pragma once
 
 #include <string>

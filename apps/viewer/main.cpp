@@ -8,13 +8,14 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "apps/viewer/controls.hpp"
 #include "apps/viewer/panel.hpp"
 #include "apps/viewer/renderer.hpp"
 #include "chapters/registry.hpp"
+#include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
@@ -76,8 +77,16 @@ void write_screenshot(const std::string& path, int width, int height) {
   glReadBuffer(GL_BACK);
   glReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
   stbi_flip_vertically_on_write(1);  // OpenGL's rows start at the bottom
-  if (!stbi_write_png(path.c_str(), width, height, 3, pixels.data(), 3 * width))
-    throw std::runtime_error("cannot write the screenshot " + path);
+  // Into memory, then written whole (common/atomic_file.hpp): stb's own file writer does not
+  // say when the disk is full.
+  std::string png;
+  const auto append = [](void* to, void* data, int size) {
+    static_cast<std::string*>(to)->append(static_cast<const char*>(data),
+                                          static_cast<std::size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, width, height, 3, pixels.data(), 3 * width))
+    throw std::runtime_error("cannot encode the screenshot " + path);
+  fem::write_file_atomically(path, png);
   std::cout << "fem_viewer: screenshot written to " << path << "\n";
 }
 
@@ -100,9 +109,7 @@ struct RunRecord {
   Eigen::Vector3d node_at_grab = Eigen::Vector3d::Zero(), target = Eigen::Vector3d::Zero();
 };
 
-void write_report(const std::string& path, const RunRecord& r, const fv::Session& session) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write the report " + path);
+void write_report(std::ostream& out, const RunRecord& r, const fv::Session& session) {
   out.precision(17);
   // What the frame rate depends on: the renderer (a GPU or Mesa's software llvmpipe), the
   // CPU that steps and may also draw, and how the stepper was compiled.
@@ -130,7 +137,6 @@ void write_report(const std::string& path, const RunRecord& r, const fv::Session
                          ? Eigen::Vector3d(session.state().x.segment<3>(3 * r.grabbed_node))
                          : Eigen::Vector3d::Zero())
       << "\n}\n";
-  std::cout << "fem_viewer: report written to " << path << "\n";
 }
 
 // Steps the session as the clock mode says; returns the seconds spent stepping.
@@ -276,7 +282,11 @@ void report_run(const RunRecord& record, const fv::Session& session, const Optio
             << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
             << session.chapter() << ", mean step "
             << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1) << " ms\n";
-  if (!options.report.empty()) write_report(options.report, record, session);
+  if (!options.report.empty()) {
+    fem::write_file_atomically(options.report,
+                               [&](std::ostream& out) { write_report(out, record, session); });
+    std::cout << "fem_viewer: report written to " << options.report << "\n";
+  }
 }
 
 void run(GLFWwindow* window, std::unique_ptr<fv::Session>& session, const Options& options) {
@@ -371,6 +381,15 @@ Options viewer_options(const fem::ArgParser& args) {
   const bool scripted = !args.get("replay-drag").empty() || !options.screenshot.empty();
   if (scripted && options.frames == 0)
     throw UsageError("--replay-drag and --screenshot need --frames N");
+  // The files the run ends with, checked before the work (the window, the frames).
+  for (const auto& [name, path] :
+       {std::pair{"screenshot", options.screenshot}, std::pair{"report", options.report}}) {
+    try {
+      if (!path.empty()) fem::check_writable(path);
+    } catch (const fem::WriteError& e) {
+      throw UsageError(std::string("--") + name + ": " + e.what());
+    }
+  }
   if (!args.get("replay-drag").empty()) {
     try {
       options.replay = fv::DragReplay::parse(args.get("replay-drag"), options.frames);

@@ -6,7 +6,7 @@
 //    of prepare() and of one V-cycle in SpMV-equivalents, and PCG from a zero guess with the
 //    V-cycle, with chapter 09's block Jacobi and with Eigen's IncompleteCholesky CG;
 //  - with --export DIR: that system as Matrix Market (A.mtx, b.mtx, the filtered rigid-body
-//    modes B.mtx) and summary.json, for scripts/pyamg_reference.py.
+//    modes B.mtx) and summary.json, for fem-tools runs pyamg.
 // The report goes to stderr, the table (for --readme) to stdout.
 #include "chapters/10_multigrid/lesson.hpp"
 
@@ -25,6 +25,7 @@
 #include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
+#include "common/atomic_file.hpp"
 #include "common/threads.hpp"
 
 namespace fem::ch10 {
@@ -208,7 +209,7 @@ FromZero from_zero(MultigridStepper& stepper, const Scene& scene, const SolverSe
   return out;
 }
 
-// The last system as Matrix Market for scripts/pyamg_reference.py, and a summary.
+// The last system as Matrix Market for fem-tools runs pyamg, and a summary.
 void export_system(const LessonRun& run, const MultigridStepper& stepper, const FromZero& z,
                    const std::string& dir) {
   const Scene& scene = run.scene;
@@ -219,12 +220,14 @@ void export_system(const LessonRun& run, const MultigridStepper& stepper, const 
       !Eigen::saveMarket(Eigen::SparseMatrix<double>(rigid_body_modes(scene).sparseView()),
                          dir + "/B.mtx"))
     throw std::runtime_error("cannot write Matrix Market files into '" + dir + "'");
-  std::ofstream(dir + "/summary.json")
-      << "{\"mesh\": \"" << mesh_name(scene) << "\", \"scene\": \"" << scene.name
-      << "\", \"nodes\": " << scene.mesh.num_nodes() << ", \"tolerance\": " << std::defaultfloat
-      << solver_from_args(run.args).tolerance << ", \"ours_iterations\": " << z.v_cycle.iterations
-      << ", \"block_jacobi_iterations\": " << z.jacobi.iterations
-      << ", \"ours_levels\": " << stepper.multigrid().levels() << "}\n";
+  std::ostringstream summary;
+  summary << "{\"mesh\": \"" << mesh_name(scene) << "\", \"scene\": \"" << scene.name
+          << "\", \"nodes\": " << scene.mesh.num_nodes() << ", \"tolerance\": " << std::defaultfloat
+          << solver_from_args(run.args).tolerance
+          << ", \"ours_iterations\": " << z.v_cycle.iterations
+          << ", \"block_jacobi_iterations\": " << z.jacobi.iterations
+          << ", \"ours_levels\": " << stepper.multigrid().levels() << "}\n";
+  write_file_atomically(dir + "/summary.json", summary.str());
   std::cerr << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
 }
 

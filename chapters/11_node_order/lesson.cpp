@@ -25,7 +25,7 @@ struct Run {
   std::vector<double> element_ms, iterations;
 };
 
-// The chapter's own orders on the scene, and gmsh's where scripts/renumber_meshes.py wrote a
+// The chapter's own orders on the scene, and gmsh's where fem-tools runs renumber-meshes wrote a
 // copy of the mesh beside the generated meshes (meshes/generated/NAME_rcmk.msh, ...).
 std::vector<Run> runs_for(const LessonRun& run) {
   std::vector<Run> runs;
@@ -97,8 +97,9 @@ std::string one_mesh_table(const LessonRun& run) {
       << "Bandwidth: max |i - j| over coupled nodes; envelope: mean of i - min j over rows; "
       << "element spread: mean of the largest minus the smallest node number of an element. "
       << "`original` keeps the file's numbering and element order (chapter 10); `gmsh` rows: "
-      << "the file renumbered by gmsh's computeRenumbering (scripts/renumber_meshes.py), its "
-      << "elements sorted as chapter 11 sorts them. " << measured_on() << ".\n";
+      << "the file renumbered by gmsh's computeRenumbering "
+      << "(tools/femtools/runs/renumber_meshes.py), its elements sorted as chapter 11 sorts them. "
+      << measured_on() << ".\n";
   return out.str();
 }
 

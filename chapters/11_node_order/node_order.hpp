@@ -31,7 +31,7 @@ namespace fem::ch11 {
 enum class Ordering {
   original,  // the mesh file's numbering, elements in the file's order (chapter 10's run)
   file,      // the mesh file's numbering, elements sorted along it (a file renumbered by
-             // gmsh's computeRenumbering: scripts/renumber_meshes.py)
+             // gmsh's computeRenumbering: fem-tools runs renumber-meshes)
   rcm,       // reverse Cuthill-McKee
   morton,    // Z-order curve on the rest positions
 };

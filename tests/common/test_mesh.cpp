@@ -72,6 +72,27 @@ TEST_CASE("a mesh without tetrahedra is reported", "[mesh]") {
   CHECK_THROWS_WITH(load_mesh(path), contains_text("no tetrahedra"));
 }
 
+TEST_CASE("10-node tetrahedra are refused as what they are, with what to do", "[mesh]") {
+  const auto path = write_msh("tet10",
+                              {"0 0 0", "1 0 0", "0 1 0", "0 0 1", "0.5 0 0", "0.5 0.5 0",
+                               "0 0.5 0", "0 0 0.5", "0 0.5 0.5", "0.5 0 0.5"},
+                              {{11, "1 2 3 4 5 6 7 8 9 10"}});
+  CHECK_THROWS_AS(load_mesh(path), MeshError);
+  CHECK_THROWS_WITH(load_mesh(path), contains_text("1 Tetrahedron 10 (gmsh type 11, 10 nodes)") &&
+                                         contains_text("setOrder(1)"));
+}
+
+TEST_CASE("tetrahedra beside hexahedra are refused, not loaded without the hexahedra", "[mesh]") {
+  const auto path = write_msh(
+      "tet_hex", {"0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1", "0 0 2"},
+      {{5, "1 2 3 4 5 6 7 8"}, {5, "1 2 3 4 5 6 7 8"}, {4, "5 6 8 9"}});
+  CHECK_THROWS_WITH(load_mesh(path), contains_text("2 Hexahedron 8 (gmsh type 5, 8 nodes)") &&
+                                         contains_text("tetrahedra only"));
+  // The tetrahedron alone loads.
+  CHECK(load_mesh(write_msh("tet_alone", {"0 0 1", "1 0 1", "0 1 1", "0 0 2"}, {{4, "1 2 3 4"}}))
+            .num_tets() == 1);
+}
+
 TEST_CASE("a degenerate tetrahedron is reported", "[mesh]") {
   const auto path = write_msh("flat", {"0 0 0", "1 0 0", "0 1 0", "1 1 0"}, {{4, "1 2 3 4"}});
   CHECK_THROWS_WITH(load_mesh(path), contains_text("degenerate"));

@@ -4,6 +4,7 @@
 // Eigen/src/SparseCore/SparseDenseProduct.h) stay on one thread too. And the registry's
 // order: each variant right after its original.
 #include <Eigen/Core>
+#include <cstdlib>
 #include <filesystem>
 
 #include "chapters/06_custom_pcg/stepper.hpp"
@@ -125,4 +126,26 @@ TEST_CASE("the registry lists each variant right after its original", "[registry
         list[i - 1].variant_of.empty() ? list[i - 1].id : list[i - 1].variant_of;
     CHECK(before == list[i].variant_of);
   }
+}
+
+TEST_CASE(
+    "OMP_NUM_THREADS is checked as --threads is: refused above the limit, warned above "
+    "the hardware threads",
+    "[threads]") {
+  const char* previous = std::getenv("OMP_NUM_THREADS");
+  const std::string kept = previous ? previous : "";
+  const auto set = [](int n) { ::setenv("OMP_NUM_THREADS", std::to_string(n).c_str(), 1); };
+  set(thread_limit() + 1);
+  CHECK_THROWS_WITH(check_thread_environment(),
+                    test::contains_text("OMP_NUM_THREADS=" + std::to_string(thread_limit() + 1)) &&
+                        test::contains_text("--threads"));
+  if (openmp_enabled() && thread_limit() > static_cast<int>(hardware_threads())) {
+    set(static_cast<int>(hardware_threads()) + 1);
+    CHECK_THAT(check_thread_environment(), test::contains_text("oversubscribed"));
+  }
+  set(1);
+  CHECK(check_thread_environment().empty());
+  ::unsetenv("OMP_NUM_THREADS");
+  CHECK(check_thread_environment().empty());
+  if (previous) ::setenv("OMP_NUM_THREADS", kept.c_str(), 1);
 }

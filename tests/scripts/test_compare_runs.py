@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""scripts/compare_runs.py on two recorded runs: the committed fixture
+"""fem-tools course compare on two recorded runs: the committed fixture
 (tests/fixtures/bench_fixture.json) as the reference, recorded on an AVX2 machine, and a copy of
 it recorded on an AVX-512 machine whose chapter 07 solves in half the time. The comparison must
 name the instruction set as what differs in the records, mark chapter 07's solve and nothing
@@ -36,7 +36,7 @@ def with_record(data, isa):
 
 
 def compare(*args):
-    return subprocess.run([sys.executable, str(ROOT / "scripts" / "compare_runs.py"), *map(str, args)],
+    return subprocess.run([sys.executable, "-m", "femtools", "course", "compare", *map(str, args)],
                           capture_output=True, text=True)
 
 
@@ -52,7 +52,7 @@ def main():
         (tmp / "run" / "bench.json").write_text(json.dumps(run))
         (tmp / "reference.json").write_text(json.dumps(reference))
         p = compare(tmp / "run", tmp / "reference.json")
-        check("compare_runs.py runs on the two runs", p.returncode == 0, p.stdout + p.stderr)
+        check("fem-tools course compare runs on the two runs", p.returncode == 0, p.stdout + p.stderr)
         check("the records' difference is the instruction set",
               re.search(r"instruction set \(build\): AVX-512 \| AVX2", p.stdout)
               and re.search(r"instruction set \(CPU\): AVX-512 \| AVX2", p.stdout), p.stdout)

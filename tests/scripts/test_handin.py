@@ -13,6 +13,8 @@ import subprocess
 import sys
 import tempfile
 
+from femtools.course import handin as check_handin
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PLOTS = ["phases.png", "speedup.png", "allocations.png", "solvers.png"]
 results = {"passed": 0, "failed": 0}
@@ -25,6 +27,44 @@ def check(name, condition, detail=""):
 
 def run(*args, cwd=ROOT):
     return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd)
+
+
+def links_cases(tmp, run_json):
+    """The hand-in check reads and writes only regular files inside the hand-in."""
+    handin = [sys.executable, "-m", "femtools", "course", "handin", "--no-tests"]
+    outside = tmp / "outside"
+    outside.mkdir()
+    # A dangling link where the check would write the diff: nothing is created outside.
+    dangling = tmp / "handin_dangling"
+    dangling.mkdir()
+    (dangling / "bench.json").write_bytes(run_json)
+    (dangling / "06_custom_pcg.diff").symlink_to(outside / "written_through_the_link.diff")
+    p = run(*handin, dangling)
+    check("handin-check refuses a hand-in holding a dangling link, naming it",
+          p.returncode != 0 and "symbolic links" in p.stderr and "06_custom_pcg.diff" in p.stderr,
+          p.stdout + p.stderr)
+    check("... and writes nothing through it", not any(outside.iterdir()), list(outside.iterdir()))
+    # A link to a file outside: not read.
+    (outside / "bench.json").write_bytes(run_json)
+    linked = tmp / "handin_linked"
+    linked.mkdir()
+    (linked / "bench.json").symlink_to(outside / "bench.json")
+    p = run(*handin, linked)
+    check("handin-check refuses bench.json as a link to a file outside the hand-in",
+          p.returncode != 0 and "symbolic links" in p.stderr and "bench.json" in p.stderr, p.stderr)
+    # Names that climb out of chapters/: in the run's record, on the command line.
+    climbing = tmp / "handin_climbing"
+    climbing.mkdir()
+    record = json.loads(run_json)
+    record["chapters"][0]["chapter"] = "../../outside"
+    (climbing / "bench.json").write_text(json.dumps(record))
+    p = run(*handin, climbing)
+    check("handin-check refuses a chapter name with '..' in the run's record",
+          p.returncode != 0 and "'../../outside' is not a plain name" in p.stderr, p.stderr)
+    (climbing / "bench.json").write_bytes(run_json)
+    p = run(*handin, climbing, "--variant", "../06_custom_pcg")
+    check("handin-check refuses a --variant with '..'",
+          p.returncode != 0 and "not a plain name" in p.stderr, p.stderr)
 
 
 def main():
@@ -53,7 +93,7 @@ def main():
               and (student / "bench.json").read_bytes() == first, p.stdout[-300:] + p.stderr)
         p = run(*bench, "--out", student, "--no-solvers", "--replace")
         check("--replace replaces it and says so",
-              p.returncode == 0 and "replacing the run that was there" in p.stdout, p.stdout[-300:])
+              p.returncode == 0 and "replaced the run that was there" in p.stdout, p.stdout[-300:])
         p = run(*bench, "--out", student, "--replace")  # the hand-in: a full run again
         first = (student / "bench.json").read_bytes()
 
@@ -71,9 +111,7 @@ def main():
               f"{folders} {p.stderr}")
 
         # The JSON ties each chapter's row to its sources: the hash the build recorded equals the
-        # one the hand-in check computes from the folder (scripts/check_handin.py).
-        sys.path.insert(0, str(ROOT / "scripts"))
-        import check_handin  # noqa: E402
+        # one the hand-in check computes from the folder (fem-tools course handin).
         rows = json.loads((student / "bench.json").read_text())["chapters"]
         check("each row records the hash of its chapter's sources, as the hand-in check computes it",
               all(r.get("source_hash") == check_handin.source_hash(ROOT / "chapters" / r["chapter"])
@@ -96,12 +134,13 @@ def main():
         teacher = tmp / "teacher"
         teacher.mkdir()
         (teacher / "bench.json").write_bytes(first)
-        p = run(ROOT / ".venv" / "bin" / "python", ROOT / "scripts" / "plot_results.py",
+        p = run(sys.executable, "-m", "femtools", "plots", "bench",
                 teacher / "bench.json", "--out", teacher)
         check("the teacher's regeneration exits 0", p.returncode == 0, p.stderr)
         for png in PLOTS:
             same = (teacher / png).exists() and (teacher / png).read_bytes() == (student / png).read_bytes()
             check(f"the teacher regenerates the student's {png} byte for byte", same)
+        links_cases(tmp, first)
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""scripts/plot_roofline.py --check on copies of the committed roofline data
+"""fem-tools plots roofline --check on copies of the committed roofline data
 (docs/data/lessons/roofline.json): with every measured time at least its bound it passes;
 one phase measured below its bound (above 100% of it) is refused, and named; a phase without
 its bytes written is refused; the same data marked provisional pass with a warning. Prints
@@ -25,7 +25,7 @@ def check(name, condition, detail=""):
 def run_check(record, folder, name):
     path = pathlib.Path(folder) / name
     path.write_text(json.dumps(record))
-    return subprocess.run([sys.executable, str(ROOT / "scripts" / "plot_roofline.py"), str(path), "--check"],
+    return subprocess.run([sys.executable, "-m", "femtools", "plots", "roofline", str(path), "--check"],
                           capture_output=True, text=True)
 
 

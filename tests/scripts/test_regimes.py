@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Test of the regime sweep's driver: a short run of scripts/regimes.py on the test mesh with
+"""Test of the regime sweep's driver: a short run of `fem-tools runs regimes` on the test mesh with
 two values of E writes a regimes.json that passes the schema check, with every chapter of the
 registry at every point and chapter 01's CG iterations rising with stiffness; the plot and the
 generated docs sections come from it; the schema check rejects broken copies.
@@ -16,10 +16,10 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SCRIPTS = ROOT / "scripts"
-sys.path.insert(0, str(SCRIPTS))
-import regimes_common  # noqa: E402
-import update_docs  # noqa: E402
+from femtools.docs import regime_tables
+from femtools.docs import update as update_docs
+from femtools.results import poster
+from femtools.results import regimes as regimes_common
 
 results = {"passed": 0, "failed": 0}
 SOFT, STIFF = 1e4, 1e6
@@ -46,20 +46,20 @@ def main():
         tmp = pathlib.Path(sys.argv[2]) if len(sys.argv) > 2 else pathlib.Path(tmp)
         tmp.mkdir(parents=True, exist_ok=True)
         out = tmp / "regimes.json"
-        p = subprocess.run([sys.executable, str(SCRIPTS / "regimes.py"), "--bench", bench,
+        p = subprocess.run([sys.executable, "-m", "femtools", "runs", "regimes", "--bench", bench,
                             "--bodies", str(ROOT / "meshes" / "test_beam.msh"), "--E", f"{STIFF:g},{SOFT:g}",
                             "--steps", "2", "--warmup", "1", "--out", str(out)],
                            capture_output=True, text=True)
-        check("regimes.py exits 0", p.returncode == 0, p.stderr)
-        check("regimes.py reports progress per point", "[2/2] test_beam.msh" in p.stdout, p.stdout[-500:])
+        check("fem-tools runs regimes exits 0", p.returncode == 0, p.stderr)
+        check("fem-tools runs regimes reports progress per point", "[2/2] test_beam.msh" in p.stdout, p.stdout[-500:])
         if p.returncode != 0:
             return
         data = json.loads(out.read_text())
         problems = regimes_common.validate_regimes(data)
         check("the JSON passes the schema check", not problems, "; ".join(problems))
-        v = subprocess.run([sys.executable, str(SCRIPTS / "validate_bench.py"), "--regimes", str(out)],
+        v = subprocess.run([sys.executable, "-m", "femtools", "results", "validate", "--regimes", str(out)],
                            capture_output=True, text=True)
-        check("validate_bench.py --regimes accepts it", v.returncode == 0, v.stderr)
+        check("fem-tools results validate --regimes accepts it", v.returncode == 0, v.stderr)
         check("two points, sorted by E", [pt["E"] for pt in data["points"]] == [SOFT, STIFF],
               str([pt["E"] for pt in data["points"]]))
         expected = registry_chapters(bench, tmp)
@@ -78,11 +78,11 @@ def main():
 
         # The generated sections: one row per poster number, from this JSON.
         statements = regimes_common.poster_statements(data)
-        for _, label, target in regimes_common.POSTER_NUMBERS:
+        for _, label, target in poster.NUMBERS:
             check(f"the statements name the poster's x{target:g}", f"x{target:g}" in statements)
-        table = update_docs.regimes_points_table(data)
+        table = regime_tables.regimes_points_table(data)
         check("the points table has a row per point", table.count("`test_beam`") == 2, table)
-        solvers = update_docs.regimes_solvers_table(data)
+        solvers = regime_tables.regimes_solvers_table(data)
         check("the solve table shows the softest and the stiffest point",
               f"E = {SOFT:g}" in solvers and f"E = {STIFF:g}" in solvers, solvers)
         repo = tmp / "repo"
@@ -109,9 +109,9 @@ def main():
             broken = copy.deepcopy(data)
             breaks(broken)
             check(f"the schema check rejects {name}", bool(regimes_common.validate_regimes(broken)))
-        bad = subprocess.run([sys.executable, str(SCRIPTS / "regimes.py"), "--bench", bench, "--E", "0"],
+        bad = subprocess.run([sys.executable, "-m", "femtools", "runs", "regimes", "--bench", bench, "--E", "0"],
                              capture_output=True, text=True)
-        check("regimes.py refuses E = 0 with a message", bad.returncode == 2 and "positive" in bad.stderr,
+        check("fem-tools runs regimes refuses E = 0 with a message", bad.returncode == 2 and "positive" in bad.stderr,
               bad.stderr)
 
 

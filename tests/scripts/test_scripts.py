@@ -12,11 +12,12 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SCRIPTS = ROOT / "scripts"
 FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
-sys.path.insert(0, str(SCRIPTS))
-import update_docs  # noqa: E402
-from results_common import chapter_dir, validate_bench, validate_viewer  # noqa: E402
+from femtools.docs import markdown
+from femtools.plots import bench as plot_results
+from femtools.plots import style as plot_style
+from femtools.results.common import chapter_dir, footer
+from femtools.results.schema import validate_bench, validate_viewer
 
 results = {"passed": 0, "failed": 0}
 
@@ -27,7 +28,7 @@ def check(name, condition, detail=""):
 
 
 def run(*args):
-    return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "femtools", *map(str, args)], capture_output=True, text=True)
 
 
 def scaling_fixture(bench):
@@ -66,18 +67,18 @@ def main():
 
         # Plots: every file written and non-empty.
         out = tmp / "plots"
-        p = run(SCRIPTS / "plot_results.py", FIXTURE, "--scaling", scaling, "--out", out)
-        check("plot_results.py exits 0", p.returncode == 0, p.stderr)
-        p = run(SCRIPTS / "plot_results.py", "--threads", FIXTURE, "--out", out)
-        check("plot_results.py --threads exits 0", p.returncode == 0, p.stderr)
+        p = run("plots", "bench", FIXTURE, "--scaling", scaling, "--out", out)
+        check("fem-tools plots bench exits 0", p.returncode == 0, p.stderr)
+        p = run("plots", "bench", "--threads", FIXTURE, "--out", out)
+        check("fem-tools plots bench --threads exits 0", p.returncode == 0, p.stderr)
         for png in ["phases", "phases_stacked", "speedup", "allocations", "solvers", "scaling", "threads"]:
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
                   f"{f} missing or small")
         # The figures of chapters 10-12 from the committed data (docs/data/figures/) and
         # chapter 12's sources; a mesh numbered otherwise than the code's record is refused.
-        p = run(SCRIPTS / "figures.py", "--out", out)
-        check("figures.py exits 0", p.returncode == 0, p.stderr)
+        p = run("plots", "figures", "--out", out)
+        check("fem-tools plots figures exits 0", p.returncode == 0, p.stderr)
         for png in ["vcycle", "aggregates", "node_orders", "padded_lanes", "soa_batch"]:
             f = out / f"{png}.png"
             check(f"{png}.png written and non-empty", f.exists() and f.stat().st_size > 10_000,
@@ -87,16 +88,15 @@ def main():
         record = json.loads((ROOT / "docs" / "data" / "figures" / "hierarchy.json").read_text())
         record["tet_checksum"] += 1
         (data / "hierarchy.json").write_text(json.dumps(record))
-        p = run(SCRIPTS / "figures.py", "hierarchy", "--data", data, "--out", out)
-        check("figures.py refuses a mesh not numbered as the code's record",
+        p = run("plots", "figures", "hierarchy", "--data", data, "--out", out)
+        check("fem-tools plots figures refuses a mesh not numbered as the code's record",
               p.returncode == 2 and "not numbered here" in p.stderr, p.stderr)
-        p = run(SCRIPTS / "plot_results.py", tmp / "missing.json", "--out", out)
-        check("plot_results.py on a missing file exits 2 with a message",
+        p = run("plots", "bench", tmp / "missing.json", "--out", out)
+        check("fem-tools plots bench on a missing file exits 2 with a message",
               p.returncode == 2 and "no such file" in p.stderr, p.stderr)
 
         # A variant's run without chapter 01 (--chapters 10,10_mine): each variant row over its
         # original's row at the same thread count, never a blank plot.
-        import plot_results  # noqa: E402
         variant_run = copy.deepcopy(bench)
         originals = [c for c in bench["chapters"] if chapter_dir(c["chapter"]) == "09_threads"]
         mine = []
@@ -117,7 +117,7 @@ def main():
         # into each other) pass on it, and they do catch a legend laid over the bars.
         (out / "variant").mkdir()
         (out / "variant" / "bench.json").write_text(json.dumps(variant_run))
-        p = run(SCRIPTS / "plot_results.py", out / "variant" / "bench.json", "--out", out / "variant")
+        p = run("plots", "bench", out / "variant" / "bench.json", "--out", out / "variant")
         check("a variant's run draws readable plots (the layout checks pass)", p.returncode == 0,
               p.stdout + p.stderr)
         import matplotlib.pyplot as plt  # noqa: E402
@@ -126,7 +126,7 @@ def main():
         ax.legend(loc="center")
         fig.canvas.draw()
         check("the layout check finds a legend that covers bars",
-              any("legend" in problem for problem in plot_results.layout_problems(fig)))
+              any("legend" in problem for problem in plot_style.layout_problems(fig)))
         plt.close(fig)
         two = copy.deepcopy(bench)
         two["chapters"] = [c for c in bench["chapters"] if c["chapter"] != "01_naive"][:2]
@@ -141,7 +141,7 @@ def main():
               all(min(p) >= 0 and abs(sum(p) - max(step, sum(p[:-1]))) < 1e-9 for _, p, step in rows),
               str(rows[:2]))
         check("rows on two threads are hatched, rows on one are not",
-              all((plot_results.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
+              all((plot_style.style(c)["hatch"] is not None) == (c.get("threads", 1) > 1)
                   for c in bench["chapters"]) and any(c.get("threads", 1) > 1 for c in bench["chapters"]))
 
         # A run folder holds one run's files: a run without a solve table removes the old one.
@@ -150,10 +150,9 @@ def main():
         no_solvers["machine"] = dict(no_solvers["machine"], busy=True, other_cpus=1.5)
         no_solvers["uncommitted"] = ["chapters/09_mine/stepper.cpp", "chapters/09_mine/README.md"]
         (out / "bench.json").write_text(json.dumps(no_solvers))
-        p = run(SCRIPTS / "plot_results.py", out / "bench.json", "--out", out)
+        p = run("plots", "bench", out / "bench.json", "--out", out)
         check("plots of a run without a solve table remove the folder's old solvers.png",
               p.returncode == 0 and not (out / "solvers.png").exists(), p.stdout + p.stderr)
-        from results_common import footer  # noqa: E402
         check("the footer says the machine was busy and what was measured beyond the commit",
               "BUSY MACHINE" in footer(no_solvers) and "uncommitted chapters/09_mine/" in footer(no_solvers),
               footer(no_solvers))
@@ -172,31 +171,31 @@ def main():
         shutil.copy(FIXTURE, data / "threads.json")
         viewer = viewer_fixture(bench)
         (data / "viewer.json").write_text(json.dumps(viewer))
-        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
-        check("update_docs.py --check fails on docs made from other data", p.returncode == 1,
+        p = run("docs", "update", "--root", root, "--check")
+        check("fem-tools docs update --check fails on docs made from other data", p.returncode == 1,
               p.stdout + p.stderr)
-        p = run(SCRIPTS / "update_docs.py", "--root", root)
-        check("update_docs.py exits 0", p.returncode == 0, p.stderr)
-        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
-        check("update_docs.py --check passes right after update_docs.py", p.returncode == 0,
+        p = run("docs", "update", "--root", root)
+        check("fem-tools docs update exits 0", p.returncode == 0, p.stderr)
+        p = run("docs", "update", "--root", root, "--check")
+        check("fem-tools docs update --check passes right after fem-tools docs update", p.returncode == 0,
               p.stdout + p.stderr)
         chapter02 = (root / "chapters" / "02_noalias" / "README.md").read_text()
         check("chapter 02's table has one speedup row (over 01, its previous chapter)",
               chapter02.count("| speedup over `01_naive` |") == 1)
         tampered = (root / "docs" / "results.md").read_text().replace(
-            update_docs.ms(bench["chapters"][0]["median_ms"]["step"]), "1234.5", 1)
+            markdown.ms(bench["chapters"][0]["median_ms"]["step"]), "1234.5", 1)
         (root / "docs" / "results.md").write_text(tampered)
-        p = run(SCRIPTS / "update_docs.py", "--root", root, "--check")
-        check("update_docs.py --check fails on a hand-edited number", p.returncode == 1 and
+        p = run("docs", "update", "--root", root, "--check")
+        check("fem-tools docs update --check fails on a hand-edited number", p.returncode == 1 and
               "docs/results.md" in p.stderr, p.stdout + p.stderr)
-        run(SCRIPTS / "update_docs.py", "--root", root)
+        run("docs", "update", "--root", root)
         results_md = (root / "docs" / "results.md").read_text()
         naive = next(c for c in bench["chapters"] if c["chapter"] == "01_naive")
         last = bench["chapters"][-1]
         for phase in ["dfdx", "solve", "step"]:
-            text = update_docs.ms(naive["median_ms"][phase])
+            text = markdown.ms(naive["median_ms"][phase])
             check(f"results.md shows 01's {phase} median {text}", text in results_md)
-        speed = update_docs.ratio(naive["median_ms"]["step"], last["median_ms"]["step"])
+        speed = markdown.ratio(naive["median_ms"]["step"], last["median_ms"]["step"])
         check(f"results.md shows the step speedup {speed}", speed in results_md)
         check("results.md shows the poster's x218.79", "x218.79" in results_md)
         check("results.md names the machine", bench["machine"]["cpu"] in results_md)
@@ -204,20 +203,20 @@ def main():
               all(f"`{s['name']}`" in results_md for s in bench["solvers"]))
         check("results.md shows the scaling table", "stopped" in results_md)
         readme = (root / "README.md").read_text()
-        check("README headline filled", update_docs.ms(last["median_ms"]["step"]) in readme)
+        check("README headline filled", markdown.ms(last["median_ms"]["step"]) in readme)
         check("results.md viewer table filled",
               "| drawing only (`--paused`) | 31.2 | - |" in results_md and "llvmpipe (fixture)" in results_md and
-              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {update_docs.ms(r['mean_step_ms'])} |"
+              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {markdown.ms(r['mean_step_ms'])} |"
                   in results_md for r in viewer["runs"][1:]), results_md[results_md.find("viewer-fps"):][:600])
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
-        check("chapter 01 table filled", update_docs.ms(naive["median_ms"]["forces"]) in chapter)
+        check("chapter 01 table filled", markdown.ms(naive["median_ms"]["forces"]) in chapter)
         threaded = [c for c in bench["chapters"] if "@" in c["chapter"]]
         chapter = (root / "chapters" / "09_threads" / "README.md").read_text()
         check("chapter 09 tables filled: NAME@N rows and the thread table",
               all(f"bench-table:{c['chapter']}:begin -->\n| median ms" in chapter for c in threaded) and
               "threads-table:begin -->\n| median ms" in chapter and
-              all(update_docs.ms(c["median_ms"]["step"]) in chapter for c in threaded),
+              all(markdown.ms(c["median_ms"]["step"]) in chapter for c in threaded),
               chapter[chapter.find("measured effect"):][:800])
         check("README links NAME@N rows to the chapter's directory",
               "[`09_threads@2`](chapters/09_threads/README.md)" in readme)
@@ -241,8 +240,8 @@ def main():
         check("an uncommitted list that is not a list is caught", validate_bench(broken) != [])
         bad = tmp / "broken.json"
         bad.write_text(json.dumps(broken))
-        p = run(SCRIPTS / "validate_bench.py", bad)
-        check("validate_bench.py exits 1 on a broken file", p.returncode == 1, p.stdout + p.stderr)
+        p = run("results", "validate", bad)
+        check("fem-tools results validate exits 1 on a broken file", p.returncode == 1, p.stdout + p.stderr)
 
         # The chapter drift check: a chapter copied forward and not renamed is caught.
         drift = tmp / "drift"
@@ -250,15 +249,15 @@ def main():
         (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
             '// Chapter 07: one linearized backward Euler step\n#include <iostream>\n'
             'void f() { throw 1 ? "07_block_sparse: a table does not match" : ""; }\n')
-        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
-        check("check_chapter_sources.py catches a header, a string and an unused <iostream>",
+        p = run("check", "chapter-sources", "--root", drift)
+        check("fem-tools check chapter-sources catches a header, a string and an unused <iostream>",
               p.returncode == 1 and "'Chapter 07'" in p.stderr and "names chapter 07" in p.stderr
               and "<iostream>" in p.stderr, p.stderr)
         (drift / "chapters" / "08_copied" / "stepper.cpp").write_text(
             '// Chapter 08: one step, as chapter 07 wrote it\n#include "chapters/07_x/stepper.hpp"\n'
             'void f() { throw "08_copied: a table does not match"; }\n')
-        p = run(SCRIPTS / "check_chapter_sources.py", "--root", drift)
-        check("check_chapter_sources.py accepts a chapter that names only itself",
+        p = run("check", "chapter-sources", "--root", drift)
+        check("fem-tools check chapter-sources accepts a chapter that names only itself",
               p.returncode == 0, p.stdout + p.stderr)
 
         # The size limits: a long function, a long file and a wide struct are caught, and the
@@ -277,16 +276,16 @@ def main():
             + members + "  struct Inner {\n    int a, b;\n  } inner, other;\n};\n")
         (sizes / "chapters" / "03_early" / "stepper.hpp").write_text(
             "struct Early {\n" + members + "  int more, still_more;\n};\n" + "\n" * 400)
-        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
-        check("check_sizes.py catches a long function, a long chapter file and a wide struct",
+        p = run("check", "sizes", "--root", sizes)
+        check("fem-tools check sizes catches a long function, a long chapter file and a wide struct",
               p.returncode == 1 and "f is 62 lines" in p.stderr and "Foo::Foo" not in p.stderr
               and "Wide has 19 data members" in p.stderr and "Inner" not in p.stderr
               and "stepper.hpp: 420 lines" in p.stderr and "Early has" not in p.stderr, p.stderr)
         (sizes / "common" / "long.cpp").write_text("int f(int x) {\n" + body[:-11] + "}\n")
         (sizes / "chapters" / "09_wide" / "wide.hpp").write_text("struct Wide {\n" + members + "};\n")
         (sizes / "chapters" / "03_early" / "stepper.hpp").write_text("struct Early {};\n")
-        p = run(SCRIPTS / "check_sizes.py", "--root", sizes)
-        check("check_sizes.py accepts code within the limits", p.returncode == 0, p.stdout + p.stderr)
+        p = run("check", "sizes", "--root", sizes)
+        check("fem-tools check sizes accepts code within the limits", p.returncode == 0, p.stdout + p.stderr)
 
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of ./tutorial.sh variant (scripts/make_variant.py) on a copy of the chapters: the copy
+"""Tests of ./tutorial.sh variant (fem-tools course variant) on a copy of the chapters: the copy
 is made with its namespace and includes renamed and a variant_of file; the build's registry
 generator (chapters/registry.cmake) lists it after its original with its title; it compiles
 beside the original (the generated registry includes both headers); the generated-diff check
@@ -12,6 +12,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+
+from femtools.course import handin as check_handin
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 results = {"passed": 0, "failed": 0}
@@ -32,7 +34,7 @@ def copy_repo(tmp):
     def ignore(directory, names):
         return {n for n in names if n == "__pycache__" or (pathlib.Path(directory) / n / "variant_of").exists()}
     repo = tmp / "repo"
-    for part in ("chapters", "common", "scripts", "docs/diffs"):
+    for part in ("chapters", "common", "tools", "docs/diffs"):
         shutil.copytree(ROOT / part, repo / part, ignore=ignore)
     return repo
 
@@ -44,13 +46,13 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         repo = copy_repo(pathlib.Path(tmp))
-        make = [sys.executable, repo / "scripts" / "make_variant.py", "--root", repo]
+        make = [sys.executable, "-m", "femtools", "course", "variant", "--root", repo]
         # The copy's diffs made current first, so that the check below is about the variant
         # alone (the repository's own diffs have their own test).
-        run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo)
+        run(sys.executable, "-m", "femtools", "docs", "diffs", "--root", repo)
 
         p = run(*make, "06", "my_fused_updates")
-        check("make_variant.py 06 my_fused_updates exits 0", p.returncode == 0, p.stderr)
+        check("fem-tools course variant 06 my_fused_updates exits 0", p.returncode == 0, p.stderr)
         check("its next steps name the copy's sources, the variant's own test label and the "
               "diff by name", "stepper.cpp, stepper.hpp" in p.stdout
               and "test -L ch06_my_fused_updates" in p.stdout and "--no-solvers" in p.stdout
@@ -71,12 +73,12 @@ def main():
                   "# Chapter 06_my_fused_updates: a variant of 06_custom_pcg ("))
 
         # The hand-in: the variant's change against its original with the copy's renames undone.
-        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo, "--variant",
+        p = run(sys.executable, "-m", "femtools", "docs", "diffs", "--root", repo, "--variant",
                 "06_my_fused_updates")
         check("an unchanged variant's diff is empty (renames undone)", p.returncode == 0
               and p.stdout == "", p.stdout[:2000] + p.stderr)
         (variant / "stepper.cpp").write_text(cpp.replace("namespace {", "namespace {  // changed", 1))
-        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo, "--variant",
+        p = run(sys.executable, "-m", "femtools", "docs", "diffs", "--root", repo, "--variant",
                 "06_my_fused_updates")
         check("a one-line change is one hunk of one line", p.returncode == 0
               and p.stdout.count("\n@@") + p.stdout.startswith("@@") == 1
@@ -84,10 +86,10 @@ def main():
         check("its context reads in the original's names, not the copy's",
               "ch06_my_fused_updates" not in p.stdout and "06_my_fused_updates/" not in
               p.stdout.split("\n@@")[-1], p.stdout[:2000])
-        by_name = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo,
+        by_name = run(sys.executable, "-m", "femtools", "docs", "diffs", "--root", repo,
                       "--variant", "my_fused_updates")
         check("a variant answers to its name alone", by_name.stdout == p.stdout, by_name.stderr)
-        nothing = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--root", repo,
+        nothing = run(sys.executable, "-m", "femtools", "docs", "diffs", "--root", repo,
                       "--variant", "no_such_variant")
         check("an unknown variant is refused with the known ones", nothing.returncode != 0
               and "06_my_fused_updates" in nothing.stderr, nothing.stderr)
@@ -98,7 +100,7 @@ def main():
                             (["99", "x"], "no chapter 99"),
                             (["06", "Bad-Name"], "not a variant name")):
             p = run(*make, *bad)
-            check(f"make_variant.py {' '.join(bad)} is refused ({reason})",
+            check(f"fem-tools course variant {' '.join(bad)} is refused ({reason})",
                   p.returncode == 2 and reason in p.stderr, p.stderr)
 
         p = run(ROOT / "tutorial.sh", "variant", "06")
@@ -119,8 +121,6 @@ def main():
               and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "", nullptr,' in text
               and '"", &fem::ch08::lessons,' in text, text)
         # Each entry ends with the hash of its chapter's sources, as the hand-in check computes it.
-        sys.path.insert(0, str(repo / "scripts"))
-        import check_handin  # noqa: E402
         check("each entry records its chapter's source hash",
               f'"{check_handin.source_hash(variant)}"' in text
               and f'"{check_handin.source_hash(repo / "chapters" / "01_naive")}"' in text, text[-1500:])
@@ -145,11 +145,11 @@ def main():
         shutil.rmtree(broken)
 
         # The generated-diff check ignores the variant (and still checks the course's chapters).
-        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--check", "--root", repo)
-        check("chapter_diffs.py --check leaves the variant out", p.returncode == 0, p.stderr)
+        p = run(sys.executable, "-m", "femtools", "docs", "diffs", "--check", "--root", repo)
+        check("fem-tools docs diffs --check leaves the variant out", p.returncode == 0, p.stderr)
         (repo / "chapters" / "07_block_sparse" / "stepper.cpp").write_text("// changed\n")
-        p = run(sys.executable, repo / "scripts" / "chapter_diffs.py", "--check", "--root", repo)
-        check("chapter_diffs.py --check still catches a changed chapter", p.returncode == 1, p.stdout)
+        p = run(sys.executable, "-m", "femtools", "docs", "diffs", "--check", "--root", repo)
+        check("fem-tools docs diffs --check still catches a changed chapter", p.returncode == 1, p.stdout)
 
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0

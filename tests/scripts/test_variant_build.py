@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """A variant of every chapter whose folder holds more than one source file (its stepper and
 the building blocks or lesson it teaches: 02, 03, 04, 07, 08, 09, 10) is made with
-scripts/make_variant.py in a copy of the repository, built with the rest (every .cpp of a
+`fem-tools course variant` in a copy of the repository, built with the rest (every .cpp of a
 chapter's folder is compiled), passes the checks every chapter passes (the generic tests
 under its own name), runs beside its original in one fem_bench run, and its copy of the
 lesson measures it beside the original's (fem_lessons LESSON --chapter VARIANT). Prints
@@ -35,7 +35,7 @@ def copy_repo(tmp, venv):
         return {n for n in names if n in ("__pycache__", "build", ".venv")
                 or (pathlib.Path(directory) / n / "variant_of").exists()}
     repo = tmp / "repo"
-    for part in ("chapters", "common", "apps", "tests", "scripts"):
+    for part in ("chapters", "common", "femcourse", "cmake", "apps", "tests", "tools"):
         shutil.copytree(ROOT / part, repo / part, ignore=ignore)
     (repo / "meshes").mkdir()
     for mesh in ("test_beam.msh", "plate_poster.msh"):
@@ -68,8 +68,8 @@ def main():
               {"07_block_sparse", "09_threads", "10_multigrid"} <= set(originals), originals)
         variants = []
         for original in originals:
-            p = run(sys.executable, repo / "scripts" / "make_variant.py", "--root", repo, original[:2], "mine")
-            check(f"make_variant.py {original[:2]} mine", p.returncode == 0, p.stderr)
+            p = run(sys.executable, "-m", "femtools", "course", "variant", "--root", repo, original[:2], "mine")
+            check(f"fem-tools course variant {original[:2]} mine", p.returncode == 0, p.stderr)
             variants.append(original[:2] + "_mine")
 
         # The release preset's folder, as in the original: the same depth below the root

@@ -1,0 +1,1 @@
+"""The course's Python tooling: one package, one command line (femtools.cli)."""

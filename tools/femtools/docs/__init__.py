@@ -1,0 +1,1 @@
+"""The generated docs: the results tables, the lesson tables, the chapter diffs."""

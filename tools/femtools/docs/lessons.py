@@ -1,0 +1,55 @@
+"""The lessons' tables as committed data: every docs/data/lessons/NAME.json (written by
+`fem_lessons NAME --json`, or by fem-tools runs pyamg --json) holds a table and the
+README and markers it belongs between. This script writes each table there; with --check it
+writes nothing and fails when a README's table is not its JSON's (ctest label docs), so that
+no number of a lesson is typed by hand or left behind by a rerun.
+
+    fem-tools docs lessons            # write the tables into the READMEs
+    fem-tools docs lessons --check    # are the READMEs those of the JSON?
+"""
+import json
+import sys
+
+from femtools.args import command_parser, add_root_option
+from femtools.docs.markers import replace_between
+FIELDS = ("lesson", "readme", "marker", "command", "table")
+
+
+def load(path):
+    data = json.loads(path.read_text())
+    missing = [f for f in FIELDS if f not in data]
+    if missing:
+        raise ValueError(f"{path}: no {', '.join(missing)}")
+    return data
+
+
+def main(argv=None, prog=None):
+    parser = command_parser(prog, __doc__)
+    parser.add_argument("--check", action="store_true", help="only check the READMEs")
+    add_root_option(parser)
+    args = parser.parse_args(argv)
+    paths = sorted((args.root / "docs" / "data" / "lessons").glob("*.json"))
+    if not paths:
+        print("fem-tools docs lessons: no docs/data/lessons/*.json", file=sys.stderr)
+        return 1
+    problems = []
+    for path in paths:
+        data = load(path)
+        readme = args.root / data["readme"]
+        text = readme.read_text()
+        new = replace_between(text, data["marker"], data["table"])
+        if new is None:
+            problems.append(f"{data['readme']} has no {data['marker']} markers (from {path.name})")
+        elif new != text:
+            if args.check:
+                problems.append(f"{data['readme']}: the {data['marker']} table is not {path.name}'s "
+                                f"(run fem-tools docs lessons)")
+            else:
+                readme.write_text(new)
+                print(f"wrote the {data['marker']} table of {data['readme']} from {path.name}")
+    if problems:
+        print("\n".join(problems), file=sys.stderr)
+        return 1
+    if args.check:
+        print(f"{len(paths)} lesson tables are those of docs/data/lessons/")
+    return 0

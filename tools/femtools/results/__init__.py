@@ -1,0 +1,1 @@
+"""Loading, checking and reading the results JSON (bench, scaling, regimes, viewer)."""

@@ -1,0 +1,115 @@
+"""Chapter 10's reference: PyAMG's smoothed aggregation on the same filtered systems.
+
+For each mesh, runs `fem_lessons multigrid --export` (chapter 10 for some steps, then the last step's
+filtered system S A S + I - S, its right-hand side and the filtered rigid-body modes as
+Matrix Market), builds pyamg.smoothed_aggregation_solver with the rigid-body modes as B and
+its defaults otherwise (symmetric strength with theta 0, standard aggregation, Jacobi-smoothed
+prolongator, symmetric block Gauss-Seidel), and runs PyAMG's CG with one V-cycle as the
+preconditioner from a zero guess, with the stopping rule of ours: ||r|| < tol ||b||. Prints
+a Markdown table of the iteration counts beside chapter 10's and the block-Jacobi PCG's (chapter 09)
+on the same system, also from a zero guess.
+
+    fem-tools runs pyamg --tool build/release/fem_lessons
+    fem-tools runs pyamg --json docs/data/lessons/pyamg.json
+(the second also records the table, which fem-tools docs lessons writes into chapter 10's
+README between its pyamg-table markers)
+"""
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+from femtools.args import command_parser
+from femtools.docs.markdown import table
+from femtools.docs.markers import replace_between
+from femtools.paths import ROOT
+from femtools.files import write_text
+DEFAULT_MESHES = ["plate_poster", "beam_500", "beam_1k", "beam_2k", "beam_5k", "beam_10k"]
+
+
+def mesh_path(name):
+    for folder in (ROOT / "meshes", ROOT / "meshes" / "generated"):
+        if (folder / f"{name}.msh").exists():
+            return folder / f"{name}.msh"
+    raise SystemExit(f"pyamg_reference: no mesh {name}.msh in meshes/ or meshes/generated/ "
+                     "(./tutorial.sh meshes --large generates the large beams)")
+
+
+def pyamg_iterations(folder, tol, modes):
+    import numpy as np
+    import pyamg
+    import scipy.io
+    import scipy.sparse
+
+    A = scipy.sparse.csr_matrix(scipy.io.mmread(folder / "A.mtx"))
+    b = np.asarray(scipy.io.mmread(folder / "b.mtx")).ravel()
+    B = np.asarray(scipy.sparse.csr_matrix(scipy.io.mmread(folder / "B.mtx")).todense())[:, :modes]
+    # The fixed nodes' rows of B are zero; PyAMG needs B's columns independent on each
+    # aggregate and handles the rest itself. Blocks of 3: one node's unknowns together.
+    A = scipy.sparse.bsr_matrix(A, blocksize=(3, 3))
+    ml = pyamg.smoothed_aggregation_solver(A, B=B, symmetry="hermitian", max_coarse=30)
+    residuals = []
+    x, info = pyamg.krylov.cg(A, b, x0=np.zeros_like(b), tol=tol, criteria="rr", maxiter=2000,
+                              M=ml.aspreconditioner(cycle="V"), residuals=residuals)
+    if info != 0:
+        raise SystemExit(f"pyamg_reference: PyAMG's CG did not converge (info {info})")
+    return len(residuals) - 1, len(ml.levels), ml.operator_complexity()
+
+
+def main(argv=None, prog=None):
+    parser = command_parser(prog, __doc__)
+    parser.add_argument("--tool", default=str(ROOT / "build" / "release" / "fem_lessons"))
+    parser.add_argument("--meshes", default=",".join(DEFAULT_MESHES), help="comma-separated")
+    parser.add_argument("--scene", default="cantilever")
+    parser.add_argument("--steps", type=int, default=10, help="steps before the system is taken")
+    parser.add_argument("--tol", type=float, default=1e-4)
+    parser.add_argument("--modes", type=int, choices=(3, 6), default=6)
+    parser.add_argument("--readme", help="also write the table between the pyamg-table markers")
+    parser.add_argument("--json", help="also write the table as docs/data/lessons/pyamg.json "
+                                       "(fem-tools docs lessons puts it into the README)")
+    args = parser.parse_args(argv)
+    if args.steps <= 0 or not 0 < args.tol < 1:
+        parser.error("--steps must be positive and --tol in (0, 1)")
+    if not pathlib.Path(args.tool).exists():
+        parser.error(f"no {args.tool}: build it first (cmake --build --preset release "
+                     "--target fem_lessons)")
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in args.meshes.split(","):
+            folder = pathlib.Path(tmp) / name
+            print(f"{name}: chapter 10 for {args.steps} steps, export", file=sys.stderr, flush=True)
+            subprocess.run([args.tool, "multigrid", "--mesh", str(mesh_path(name)), "--scene", args.scene,
+                            "--steps", str(args.steps), "--tol", str(args.tol),
+                            "--modes", str(args.modes), "--threads", "1", "--export", str(folder)],
+                           check=True, stdout=subprocess.DEVNULL)
+            ours = json.loads((folder / "summary.json").read_text())
+            print(f"{name}: PyAMG", file=sys.stderr, flush=True)
+            iterations, levels, complexity = pyamg_iterations(folder, args.tol, args.modes)
+            rows.append((name, ours["nodes"], ours["ours_iterations"], ours["ours_levels"],
+                         iterations, levels, complexity, ours["block_jacobi_iterations"]))
+
+    header = ["mesh", "nodes", "chapter 10 iterations (levels)",
+              "PyAMG SA iterations (levels, operator complexity)", "ratio", "chapter 09 block Jacobi"]
+    lines = [table(header, [[f"`{name}`", nodes, f"{ours} ({our_levels})", f"{theirs} ({levels}, {complexity:.2f})",
+                             f"{ours / theirs:.2f}", jacobi]
+                            for name, nodes, ours, our_levels, theirs, levels, complexity, jacobi in rows])]
+    lines.append(f"PCG from a zero guess to ||r|| < {args.tol:g} ||b|| on the filtered system of "
+                 f"step {args.steps} of the {args.scene} scene, {args.modes} modes per aggregate. "
+                 f"Generated by `fem-tools runs pyamg --meshes {args.meshes}`.")
+    text = "\n".join(lines) + "\n"
+    print(text, end="")
+    if args.readme:
+        readme = pathlib.Path(args.readme)
+        written = replace_between(readme.read_text(), "pyamg-table", text)
+        if written is None:
+            raise SystemExit(f"fem-tools runs pyamg: {readme} has no pyamg-table markers")
+        readme.write_text(written)
+        print(f"wrote {args.readme}")
+    if args.json:
+        record = {"schema_version": 1, "lesson": "pyamg", "chapter": "10_multigrid",
+                  "readme": "chapters/10_multigrid/README.md", "marker": "pyamg-table",
+                  "command": "fem-tools runs pyamg " + " ".join(sys.argv[1:] if argv is None else argv), "table": text}
+        write_text(args.json, json.dumps(record, indent=2) + "\n")
+        print(f"wrote {args.json}")
