@@ -87,9 +87,10 @@ commands:
              record them in docs/data/lessons/*.json and write them into the chapter READMEs
              (ctest -L docs checks that the READMEs hold the recorded tables), and the data of
              the figures (fem_figure_data: docs/data/figures/*.json); part of docs
-  roofline   build and measure this machine's roofs (read bandwidth of each cache level and of
-             memory, peak multiply-add rate in double and float, on 1 and every thread) and place
-             every chapter's phases under them (fem_lessons roofline; a few minutes):
+  roofline   build and measure this machine's roofs (read and write bandwidth of each cache level
+             and of memory, peak multiply-add rate in double and float, on 1 and every thread,
+             each beside likwid-bench's) and place every chapter's phases under them, over
+             fem_bench's 10 warm-up and 100 measured steps (fem_lessons roofline; a few minutes):
              results/roofline.json and results/roofline.png (docs/roofline.md explains them);
              --out DIR for another run folder, other arguments go to fem_lessons roofline
              (--chapters 12,12_mine, --meshes, --steps; fem_lessons roofline --help)
@@ -411,7 +412,7 @@ roofline() {
   if [ "${1:-}" = "--out" ]; then out="$2"; shift 2; fi
   mkdir -p "$out"
   log "the roofline: this machine's roofs and every chapter's phases under them, into $out/"
-  "$BUILD_DIR/fem_lessons" roofline --json "$out/roofline.json" "$@"
+  "$BUILD_DIR/fem_lessons" roofline --steps 100 --json "$out/roofline.json" "$@"
   fem_tools plots roofline "$out/roofline.json" --out "$out/roofline.png"
 }
 

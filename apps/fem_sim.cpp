@@ -1,5 +1,6 @@
 // fem_sim: runs a scene with one chapter's stepper and writes VTK frames (a .pvd
 // series that ParaView opens).
+#include <array>
 #include <chrono>
 #include <iostream>
 #include <optional>
@@ -8,7 +9,9 @@
 #include "common/cli.hpp"
 #include "common/deformation.hpp"
 #include "common/run_lock.hpp"
+#include "common/stepper.hpp"
 #include "common/vtk.hpp"
+#include "femcourse/simulator.hpp"
 
 namespace {
 
@@ -16,7 +19,7 @@ using namespace fem;
 
 struct Run {
   const ChapterInfo* chapter = nullptr;
-  int steps = 0, every = 0, threads = 1;
+  int steps = 0, every = 0, threads = 1, watch = -1;
   SolverSettings solver;
 };
 
@@ -27,6 +30,7 @@ void add_options(ArgParser& args) {
   args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", latest_chapter().id);
   args.option("steps", "N", "number of time steps, > 0", "200");
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
+  args.option("watch", "NODE", "print this node's final position, 17 digits (-1: none)", "-1");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
               "scene's name there is replaced; a folder another run is writing is refused)",
@@ -43,6 +47,8 @@ Run run_from_args(const ArgParser& args) {
   }
   run.steps = args.get_int("steps");
   run.every = args.get_int("every");
+  run.watch = args.get_int("watch");
+  if (run.watch < -1) throw UsageError("--watch must be a node's index, or -1 for none");
   if (run.steps <= 0) throw UsageError("--steps must be positive");
   if (run.every < 0) throw UsageError("--every must be >= 0");
   run.solver = solver_from_args(args);
@@ -65,31 +71,45 @@ void print_progress(int k, const Run& run, const Scene& scene, const StepProfile
 
 // The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
 // for a step that diverged (an error) or that left the body in trouble (common/deformation.hpp).
-void simulate(const Run& run, const Scene& scene, Stepper& stepper,
-              std::optional<VtkSeries>& series) {
-  State state = rest_state(scene);
+void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& series) {
+  const Scene& scene = body.scene();
+  const State& state = body.state();
   if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
   const DeformationProbe probe(scene);
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
   for (int k = 1; k <= run.steps; ++k) {
     const auto start = std::chrono::steady_clock::now();
-    stepper.step(state);
+    try {
+      body.step();
+    } catch (const femcourse::StepDiverged& e) {
+      throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" +
+                               e.reason +
+                               "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
+    }
     // The first step allocates the stepper's buffers: the estimate is taken from the second.
     if (k == 2)
       announce_long_run(
           "fem_sim",
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
           run.steps);
-    if (const char* why = divergence(state, stepper.profile()))
-      throw std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" + why +
-                               "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
     deformation.after_step(k, probe.check(state));
     if (series && k % run.every == 0)
       series->write_frame(k * scene.dt, scene.mesh.X, scene.mesh.tets, state.x, state.v);
-    if (k % report_every == 0 || k == run.steps) print_progress(k, run, scene, stepper.profile());
+    if (k % report_every == 0 || k == run.steps)
+      print_progress(k, run, scene, body.stepper().profile());
   }
   deformation.summary(run.steps);
+}
+
+// The watched node's position at the end, to every digit: the library's example compares
+// its own run of the same body with it (tests/CMakeLists.txt, label library).
+void print_watched(const Run& run, const femcourse::Body& body) {
+  if (run.watch < 0) return;
+  const std::array<double, 3> x = body.position(run.watch);
+  std::cout.precision(17);
+  std::cout << "node " << run.watch << " at " << x[0] << " " << x[1] << " " << x[2] << "\n";
+  std::cout.precision(6);
 }
 
 // The output folder is this run's from here to the end (common/run_lock.hpp): a second
@@ -110,14 +130,18 @@ std::optional<RunLock> lock_output(const ArgParser& args, const Run& run) {
 
 void run_scene(const ArgParser& args, const Run& run) {
   const std::optional<RunLock> lock = lock_output(args, run);
-  const Scene scene = scene_from_args(args);
+  femcourse::Body body(scene_from_args(args), run.solver, run.chapter->id);
+  const Scene& scene = body.scene();
+  if (run.watch >= scene.mesh.num_nodes())
+    throw UsageError("--watch " + std::to_string(run.watch) + ": the mesh has " +
+                     std::to_string(scene.mesh.num_nodes()) + " nodes");
   std::cout << "fem_sim: " << scene.name << " on " << scene.mesh.file << " ("
             << scene.mesh.num_nodes() << " nodes, " << scene.mesh.num_tets() << " tets), chapter "
             << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s"
             << std::endl;
-  auto stepper = run.chapter->make(scene, run.solver);
-  std::cout << "threads: " << (stepper->uses_threads() ? run.threads : 1)
-            << (stepper->uses_threads() ? "" : " (this chapter is single-threaded)") << "\n";
+  const bool threaded = body.stepper().uses_threads();
+  std::cout << "threads: " << (threaded ? run.threads : 1)
+            << (threaded ? "" : " (this chapter is single-threaded)") << "\n";
   std::optional<VtkSeries> series;
   if (run.every > 0) {
     series.emplace(args.get("out"), args.get("scene"));
@@ -126,7 +150,7 @@ void run_scene(const ArgParser& args, const Run& run) {
                 << args.get("out") << " (" << series->replaced_frames() << " frames removed)\n";
   }
   const auto start = std::chrono::steady_clock::now();
-  simulate(run, scene, *stepper, series);
+  simulate(run, body, series);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "done in " << seconds << " s";
@@ -134,6 +158,7 @@ void run_scene(const ArgParser& args, const Run& run) {
     std::cout << "; " << series->frames() << " frames, open " << series->pvd_path()
               << " in ParaView";
   std::cout << "\n";
+  print_watched(run, body);
 }
 
 }  // namespace

@@ -5,7 +5,8 @@
 #                `class <Name> [final] : public Stepper` (or `public chNN::<Name>Stepper`, a chapter's
 #                stepper it extends), constructible from (Scene, SolverSettings);
 #   README.md    starts with `# Chapter NN: <title>`, the title the apps and the results show;
-#   variant_of   (variants only) one line, the id of the chapter it was copied from.
+#   variant_of   (variants only) one line, the id of the chapter it was copied from;
+#   work.hpp     (optional) count_work for its stepper: the registry's `work` hook (chapters/work.hpp).
 #
 # Included by CMakeLists.txt, it adds the build rule; run with `cmake -P`, it writes the file.
 
@@ -116,6 +117,10 @@ foreach(header ${headers})
     string(APPEND includes "#include \"chapters/${dir}/lesson.hpp\"\n")
     set(lessons "&fem::${ns}::lessons")
   endif()
+  # Its work counts (work.hpp: `count_work(const <Stepper>&, const Scene&, const WorkCounts&)`).
+  if(EXISTS ${SOURCE_DIR}/chapters/${dir}/work.hpp)
+    string(APPEND includes "#include \"chapters/${dir}/work.hpp\"\n")
+  endif()
   fem_source_hash(source_hash ${dir})
   string(APPEND entries "      chapter<fem::${ns}::${class}>(\"${dir}\", ${title_literal}, \"${variant_of}\", ${lessons},\n"
                         "                                    \"${source_hash}\"),\n")
@@ -142,7 +147,7 @@ ChapterInfo chapter(std::string id, std::string title, std::string variant_of,
           [](const Scene& scene, const SolverSettings& s) {
             return std::unique_ptr<Stepper>(std::make_unique<ChapterStepper>(scene, s));
           },
-          std::move(variant_of), lessons, std::move(source_hash)};
+          std::move(variant_of), lessons, std::move(source_hash), work_of<ChapterStepper>()};
 }
 
 }  // namespace

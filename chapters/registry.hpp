@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "chapters/work.hpp"
 #include "common/lesson.hpp"
 #include "common/stepper.hpp"
 
@@ -23,6 +24,10 @@ struct ChapterInfo {
   // SHA-256 of the chapter folder's sources when the program was built (chapters/registry.cmake
   // says how): a run's JSON records it, so a hand-in's run is tied to the code handed in.
   std::string source_hash;
+  // How the chapter counts its own work per phase (chapters/work.hpp), from the data of the
+  // stepper its `make` returns: its work.hpp's count_work, or that of the chapter it extends
+  // (found by argument-dependent lookup on its stepper's class); empty if none counts.
+  ChapterWork work;
 };
 
 // Every chapter present, in order; each variant right after the chapter it came from. The

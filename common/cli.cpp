@@ -114,6 +114,8 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
+const char* help_notice = nullptr;  // constant-initialized: set before any use
+
 std::vector<std::string> ArgParser::get_list(const std::string& name) const {
   std::vector<std::string> items;
   std::stringstream list(get(name));
@@ -145,6 +147,7 @@ std::string ArgParser::help() const {
     out << "\n";
   }
   out << "  --help                  print this help and exit\n";
+  if (help_notice) out << "\n" << help_notice << "\n";
   return out.str();
 }
 

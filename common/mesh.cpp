@@ -1,16 +1,10 @@
 #include "common/mesh.hpp"
 
-#include <gmsh.h>
-
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <map>
-#include <mutex>
-#include <numeric>
-#include <unordered_map>
 
 namespace fem {
 namespace {
@@ -30,28 +24,6 @@ double longest_edge(const Eigen::Matrix3Xd& X, const Eigen::Vector4i& t) {
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j) l = std::max(l, (X.col(t[i]) - X.col(t[j])).norm());
   return l;
-}
-
-// gmsh keeps global state: initialize once, clear before each file.
-std::mutex& gmsh_mutex() {
-  static std::mutex m;
-  return m;
-}
-
-bool gmsh_initialized = false;
-
-void ensure_gmsh_initialized() {
-  if (gmsh_initialized) return;
-  gmsh::initialize(0, nullptr, /*readConfigFiles=*/false, /*run=*/false);
-  gmsh::option::setNumber("General.Terminal", 0);
-  gmsh::option::setNumber("General.Verbosity", 0);
-  gmsh_initialized = true;
-}
-
-// After a parse error gmsh stays "busy" and answers nothing more: start it afresh.
-void reset_gmsh() {
-  gmsh::finalize();
-  gmsh_initialized = false;
 }
 
 // How a message names node i and tetrahedron e: by the file's tags when the mesh came from a
@@ -119,33 +91,6 @@ void orient_tets(std::vector<Eigen::Vector4i>& tets, TetMesh& mesh, const MeshTa
   }
 }
 
-// Any volume element other than the 4-node tetrahedron (gmsh type 4) is refused, with the
-// types and counts found: loading the tetrahedra alone would drop the rest of the body
-// silently (tetrahedra beside hexahedra), and second-order tetrahedra (10 nodes) are another
-// element than the linear one the steppers integrate.
-void refuse_other_volume_elements(const std::string& path) {
-  std::vector<int> types;
-  gmsh::model::mesh::getElementTypes(types, 3);
-  std::string found;
-  for (const int type : types) {
-    if (type == 4) continue;
-    std::vector<std::size_t> tags, nodes;
-    gmsh::model::mesh::getElementsByType(type, tags, nodes);
-    std::string name;
-    int dim = 0, order = 0, num_nodes = 0, primary = 0;
-    std::vector<double> local;
-    gmsh::model::mesh::getElementProperties(type, name, dim, order, num_nodes, local, primary);
-    found += (found.empty() ? "" : ", ") + std::to_string(tags.size()) + " " + name +
-             " (gmsh type " + std::to_string(type) + ", " + std::to_string(num_nodes) + " nodes)";
-  }
-  if (found.empty()) return;
-  gmsh::clear();
-  fail(path, "holds volume elements other than 4-node tetrahedra: " + found +
-                 ". The programs take linear tetrahedra only: in gmsh, mesh the volume with "
-                 "tetrahedra only (no recombination, Mesh.RecombineAll = 0) at first order "
-                 "(gmsh.model.mesh.setOrder(1), or Mesh.ElementOrder = 1), and save again");
-}
-
 }  // namespace
 
 TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const std::string& name,
@@ -158,66 +103,6 @@ TetMesh make_mesh(Eigen::Matrix3Xd X, std::vector<Eigen::Vector4i> tets, const s
   mesh.tets = std::move(tets);
   mesh.boundary = boundary_triangles(mesh.tets);
   return mesh;
-}
-
-TetMesh load_mesh(const std::string& path) {
-  {
-    std::ifstream probe(path);
-    if (!probe) fail(path, "cannot open the file (missing or unreadable)");
-  }
-  std::lock_guard<std::mutex> lock(gmsh_mutex());
-  ensure_gmsh_initialized();
-  gmsh::clear();
-  try {
-    gmsh::open(path);
-  } catch (const std::exception& e) {
-    reset_gmsh();
-    fail(path, std::string("gmsh cannot read it as a mesh file: ") + e.what());
-  } catch (...) {
-    reset_gmsh();
-    fail(path, "gmsh cannot read it as a mesh file");
-  }
-
-  refuse_other_volume_elements(path);
-  std::vector<std::size_t> node_tags;
-  std::vector<double> coords, params;
-  gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, false, false);
-  std::vector<std::size_t> elem_tags, elem_nodes;
-  gmsh::model::mesh::getElementsByType(4, elem_tags, elem_nodes);  // 4 = linear tetrahedron
-  gmsh::clear();
-  if (node_tags.empty()) fail(path, "not a mesh: gmsh found no nodes in it");
-
-  // Node i is the node with the i-th smallest tag: the file's numbering, also when gmsh lists
-  // the nodes entity by entity in another order (a mesh renumbered by computeRenumbering,
-  // chapter 11). A mesh gmsh generated lists them in tag order already.
-  std::vector<std::size_t> by_tag(node_tags.size());
-  std::iota(by_tag.begin(), by_tag.end(), std::size_t{0});
-  std::sort(by_tag.begin(), by_tag.end(),
-            [&](std::size_t a, std::size_t b) { return node_tags[a] < node_tags[b]; });
-  std::unordered_map<std::size_t, int> index_of_tag;
-  index_of_tag.reserve(node_tags.size());
-  MeshTags tags;
-  tags.node.resize(node_tags.size());
-  Eigen::Matrix3Xd X(3, static_cast<Eigen::Index>(node_tags.size()));
-  for (std::size_t i = 0; i < by_tag.size(); ++i) {
-    const std::size_t k = by_tag[i];
-    index_of_tag.emplace(node_tags[k], static_cast<int>(i));
-    tags.node[i] = node_tags[k];
-    X.col(static_cast<Eigen::Index>(i)) << coords[3 * k], coords[3 * k + 1], coords[3 * k + 2];
-  }
-  std::vector<Eigen::Vector4i> tets(elem_tags.size());
-  for (std::size_t e = 0; e < elem_tags.size(); ++e) {
-    for (int k = 0; k < 4; ++k) {
-      const auto it = index_of_tag.find(elem_nodes[4 * e + k]);
-      if (it == index_of_tag.end())
-        fail(path, "tetrahedron " + std::to_string(elem_tags[e]) +
-                       " (element tag in the file) refers to an undefined node " +
-                       std::to_string(elem_nodes[4 * e + k]));
-      tets[e][k] = it->second;
-    }
-  }
-  tags.tet = std::move(elem_tags);
-  return make_mesh(std::move(X), std::move(tets), path, tags);
 }
 
 std::vector<std::vector<int>> node_adjacency(const TetMesh& mesh) {

@@ -2,44 +2,12 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <fstream>
 
 #include "apps/roofline/best_rate.hpp"
 
 namespace fem::roofline {
 
 namespace {
-
-std::string read_line(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  return line;
-}
-
-// "48K", "1024K", "32M" as the kernel writes cache sizes.
-std::size_t parse_size(const std::string& text) {
-  if (text.empty()) return 0;
-  std::size_t unit = 1;
-  if (text.back() == 'K') unit = 1024;
-  if (text.back() == 'M') unit = 1024 * 1024;
-  return static_cast<std::size_t>(std::stoull(text)) * unit;
-}
-
-// "0-1", "0,2", "0-3,8-11": how many CPUs the list names.
-int count_cpus(const std::string& list) {
-  int count = 0;
-  std::size_t start = 0;
-  while (start < list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    const std::string range = list.substr(start, comma - start);
-    const std::size_t dash = range.find('-');
-    count +=
-        dash == std::string::npos ? 1 : std::stoi(range.substr(dash + 1)) - std::stoi(range) + 1;
-    start = comma + 1;
-  }
-  return std::max(count, 1);
-}
 
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kLanes = Eigen::internal::packet_traits<double>::size;
@@ -67,32 +35,31 @@ double read_pass(const Eigen::VectorXd& a) {
   return predux(sum[0]);
 }
 
-}  // namespace
+// One pass of the write kernel: a packet store per packet of the array, kSums packets per
+// stride as the read's (pstore, Eigen/src/Core/GenericPacketMath.h), of a value that changes
+// per pass so that no pass is dropped.
+double write_pass(Eigen::VectorXd& a) {
+  using namespace Eigen::internal;
+  const Packet value = pset1<Packet>(a[0] + 1.0);
+  double* data = a.data();
+  for (Eigen::Index i = 0; i < a.size(); i += kStride)
+    for (int k = 0; k < kSums; ++k) pstore(data + i + k * kLanes, value);
+  return a[0];
+}
 
-std::string CacheLevel::name() const { return "L" + std::to_string(level); }
+}  // namespace
 
 std::vector<CacheLevel> cache_levels() {
   std::vector<CacheLevel> levels;
-  const std::string root = "/sys/devices/system/cpu/cpu0/cache/index";
-  for (int index = 0; index < 16; ++index) {
-    const std::string dir = root + std::to_string(index) + "/";
-    const std::string type = read_line(dir + "type");
-    if (type.empty()) break;
-    if (type == "Instruction") continue;
-    CacheLevel c;
-    c.level = std::atoi(read_line(dir + "level").c_str());
-    c.bytes = parse_size(read_line(dir + "size"));
-    c.shared_by = count_cpus(read_line(dir + "shared_cpu_list"));
-    if (c.level > 0 && c.bytes > 0) levels.push_back(c);
-  }
+  for (const CacheLevel& c : machine_record().caches)
+    if (c.type != "Instruction" && c.level > 0 && c.bytes > 0) levels.push_back(c);
   std::sort(levels.begin(), levels.end(),
             [](const CacheLevel& a, const CacheLevel& b) { return a.level < b.level; });
-  return levels;
+  return levels.empty() ? fallback_levels() : levels;
 }
 
 std::vector<CacheLevel> fallback_levels() {
-  return {
-      {1, std::size_t(32) << 10, 1}, {2, std::size_t(1) << 20, 1}, {3, std::size_t(32) << 20, 64}};
+  return {{1, "Data", 32LL << 10, 1}, {2, "Unified", 1LL << 20, 1}, {3, "Unified", 32LL << 20, 64}};
 }
 
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads) {
@@ -101,9 +68,9 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
   for (const CacheLevel& c : caches) {
     // A shared cache holds every thread's data: each thread gets its share.
     const int sharing = std::min(std::max(threads, 1), c.shared_by);
-    const std::size_t per_thread = c.bytes / static_cast<std::size_t>(sharing);
-    levels.push_back({c.name(), per_thread, per_thread / 2});
-    largest = std::max(largest, c.bytes);
+    const std::size_t per_thread = std::size_t(c.bytes) / static_cast<std::size_t>(sharing);
+    levels.push_back({"L" + std::to_string(c.level), per_thread, per_thread / 2});
+    largest = std::max(largest, std::size_t(c.bytes));
   }
   const std::size_t memory = std::max<std::size_t>(largest, std::size_t(8) << 20) * 4;
   levels.push_back({"memory", 0, memory / static_cast<std::size_t>(std::max(threads, 1))});
@@ -116,6 +83,16 @@ double read_bandwidth(std::size_t bytes, int threads, double seconds) {
       threads, seconds, double(n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
       [](const Eigen::VectorXd& a) { return read_pass(a); });
+}
+
+int read_sums() { return kSums; }
+
+double write_bandwidth(std::size_t bytes, int threads, double seconds) {
+  const std::size_t n = elements(bytes);
+  return best_rate(
+      threads, seconds, double(n * sizeof(double)),
+      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
+      [](Eigen::VectorXd& a) { return write_pass(a); });
 }
 
 double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds) {

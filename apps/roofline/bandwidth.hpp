@@ -1,27 +1,21 @@
-// The roofline's bandwidth roofs: how many bytes per second this machine reads from each level
-// of its memory hierarchy, on one thread and on several (Williams, Waterman & Patterson,
-// "Roofline: an insightful visual performance model for multicore architectures", CACM 52(4),
-// 2009). Measured, not looked up: the vendor's number is a bus's width times its clock, which
-// no loop reaches, and STREAM's triad (McCalpin 1995) mixes reads and writes, while every pass
-// of a step reads far more than it writes (the matrix, the element data).
+// The roofline's bandwidth roofs: how many bytes per second this machine reads from, and writes
+// to, each level of its memory hierarchy, on one thread and on a team: the cache-aware roofline
+// (Ilic, Pratas & Sousa, "Cache-aware Roofline model: upgrading the loft", IEEE CAL 13(1), 2014),
+// one roof per level, beside the DRAM roof of Williams, Waterman & Patterson (CACM 52(4), 2009).
+// Measured, not looked up: the vendor's number is a bus's width times its clock, which no loop
+// reaches. STREAM's triad (McCalpin 1995) is shown beside them.
 #pragma once
 
 #include <cstddef>
 #include <string>
 #include <vector>
 
+#include "common/machine_record.hpp"
+
 namespace fem::roofline {
 
-// One data or unified cache as the kernel reports it (/sys/devices/system/cpu/cpu0/cache).
-struct CacheLevel {
-  int level = 0;             // 1, 2, 3
-  std::size_t bytes = 0;     // capacity of one instance
-  int shared_by = 1;         // hardware threads that share one instance
-  std::string name() const;  // "L1", "L2", ...
-};
-
-// The data caches of cpu0, innermost first; empty where the system does not say (then the
-// lesson sweeps sizes instead: fallback_levels).
+// The data and unified caches of machine_record(), innermost first; fallback_levels() where
+// the system does not say.
 std::vector<CacheLevel> cache_levels();
 // 32 KiB, 1 MiB, 32 MiB: a guess that stands in where cache_levels() is empty.
 std::vector<CacheLevel> fallback_levels();
@@ -42,6 +36,15 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
 // `bytes` over and over for about `seconds`: the best of several timed repetitions, since a
 // roof is what the machine can do, and a slower repetition only says something else ran.
 double read_bandwidth(std::size_t bytes, int threads, double seconds);
+
+// The best write bandwidth (bytes stored per second): every thread fills its own array of
+// `bytes` with packet stores. Where the array is not in the level (memory), each store's
+// line is first read (write-allocate): the roof prices that read with the store.
+double write_bandwidth(std::size_t bytes, int threads, double seconds);
+
+// The independent packet sums of the read kernel (an addition's latency times the loads a
+// core issues per cycle), for the lesson's text.
+int read_sums();
 
 // The same read, by another kernel: Eigen's own sum (DenseBase::sum, Eigen/src/Core/Redux.h)
 // of a VectorXd per thread. The roof's second, independent measurement.

@@ -6,7 +6,6 @@
 #include "apps/roofline/report.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
-#include "common/mesh.hpp"
 
 namespace fem::roofline {
 
@@ -32,31 +31,25 @@ std::vector<const ChapterInfo*> chapters_of(const std::string& list) {
   return out;
 }
 
-// The run's scene with another mesh (same scene, material, time step, damping).
-Scene on_mesh(const Scene& scene, const std::string& path) {
-  Scene other = make_scene(scene.name, load_mesh(path), scene.material);
-  other.dt = scene.dt;
-  other.damping = scene.damping;
-  return other;
-}
-
 std::vector<Roofs> machine_roofs(const LessonRun& run) {
-  std::vector<CacheLevel> caches = cache_levels();
-  if (caches.empty()) caches = fallback_levels();
+  const std::vector<CacheLevel> caches = cache_levels();
   std::vector<int> counts = {1};
   if (run.args.get_int("threads-max") > 1) counts.push_back(run.args.get_int("threads-max"));
   std::vector<Roofs> roofs;
   for (const int t : counts)
-    roofs.push_back(measure_roofs(caches, t, run.args.get_double("roof-seconds")));
+    roofs.push_back(measure_roofs(caches, t, run.args.get_double("roof-seconds"),
+                                  !run.args.has_flag("no-likwid")));
   return roofs;
 }
 
 std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
   std::ostringstream out;
   out << "\nRoofs: the best of repeated timings of each kernel, every thread on its own array "
-      << "(read: a sum in " << 8 << " independent packet sums; peak: 12 independent chains of "
-      << "Eigen packet multiply-adds, " << double_lanes() << " doubles or " << float_lanes()
-      << " floats per packet), working sets from the caches in /sys/devices/system/cpu. "
+      << "(read: a sum in " << read_sums() << " independent packet sums; write: packet stores; "
+      << "peak: " << fma_chains() << " independent chains of Eigen packet multiply-adds, "
+      << double_lanes() << " doubles or " << float_lanes()
+      << " floats per packet); a team timed from the barrier that starts it to the one after its "
+      << "last thread ends; working sets from the caches in /sys/devices/system/cpu. "
       << roofs_check(roofs) << "Chapters: " << run.args.get_int("warmup") << " warm-up and "
       << run.steps << " measured steps, medians; cantilever scene. " << measured_on() << ".\n";
   return out.str();
@@ -64,21 +57,25 @@ std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
 
 std::string roofline_table(const LessonRun& run) {
   const int warmup = run.args.get_int("warmup");
-  std::vector<Scene> others;  // loaded first: a bad path fails before any measurement
-  for (const std::string& path : split(run.args.get("meshes")))
-    others.push_back(on_mesh(run.scene, path));
+  // Loaded first: a bad path fails before any measurement.
+  const std::vector<Scene> others = more_meshes(run);
   const std::vector<Roofs> roofs = machine_roofs(run);
-  std::vector<ChapterRun> runs;
+  std::vector<PlacedRun> runs;
   for (const ChapterInfo* c : chapters_of(run.args.get("chapters")))
-    for (ChapterRun& r : place_chapter(*c, run.scene, roofs, warmup, run.steps))
+    for (PlacedRun& r : place_chapter(*c, run.scene, roofs, warmup, run.steps))
       runs.push_back(std::move(r));
   for (const Scene& scene : others)
     for (const ChapterInfo* c : chapters_of(run.args.get("other-chapters")))
-      for (ChapterRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
+      for (PlacedRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
         runs.push_back(std::move(r));
-  if (run.data) *run.data = json_data(roofs, runs);
-  return roofs_table(roofs) + "\n" + chapters_table(runs) + "\n" + phases_table(runs) +
-         sentence(run, roofs);
+  const std::string provisional = run.args.get("provisional");
+  if (run.data) *run.data = json_data(roofs, runs, provisional);
+  const std::string banner =
+      provisional.empty()
+          ? ""
+          : "**Provisional data, not a measurement to read: " + provisional + ".**\n\n";
+  return banner + roofs_table(roofs) + "\n" + roofs_checked(roofs) + "\n" + chapters_table(runs) +
+         "\n" + phases_table(runs) + broken_bounds(runs) + sentence(run, roofs);
 }
 
 void add_roofline_options(ArgParser& args) {
@@ -88,8 +85,12 @@ void add_roofline_options(ArgParser& args) {
               latest_chapter().id);
   args.option("threads-max", "N", "the second thread count of the roofs and chapters 09-12",
               std::to_string(hardware_threads()));
-  args.option("warmup", "N", "unmeasured steps before the measured ones", "3");
+  args.option("warmup", "N", "unmeasured steps before the measured ones (fem_bench's default)",
+              "10");
   args.option("roof-seconds", "S", "time per roof kernel", "0.2");
+  args.flag("no-likwid", "skip likwid-bench's check of the roofs");
+  args.option("provisional", "REASON",
+              "mark the data provisional (the docs check then warns instead of refusing)", "");
 }
 
 }  // namespace

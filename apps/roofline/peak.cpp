@@ -60,5 +60,6 @@ double peak_flops_float(int threads, double seconds) { return peak_flops<float>(
 
 int double_lanes() { return Eigen::internal::packet_traits<double>::size; }
 int float_lanes() { return Eigen::internal::packet_traits<float>::size; }
+int fma_chains() { return kChains; }
 
 }  // namespace fem::roofline

@@ -16,5 +16,7 @@ double peak_flops_float(int threads, double seconds);
 // The lanes of one packet: what "the vector width the build targets" is, in numbers.
 int double_lanes();
 int float_lanes();
+// The independent multiply-add chains of the peak kernel, for the lesson's text.
+int fma_chains();
 
 }  // namespace fem::roofline

@@ -1,5 +1,6 @@
 #include "apps/roofline/placement.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "common/lesson.hpp"
@@ -19,26 +20,23 @@ double phase_seconds(const StepProfile& p, const std::string& phase) {
   throw std::logic_error("no phase '" + phase + "' in StepProfile");
 }
 
-// The counts of a student's variant are its original's (the data it copied): a fresh original
-// stepped once on the same scene, with the variant's iterations.
-std::vector<PhaseWork> counted_work(const ChapterInfo& chapter, const Stepper& stepper,
-                                    const Scene& scene, int iterations, std::string& counted_as) {
-  try {
-    return count_work(stepper, scene, iterations, counted_as);
-  } catch (const std::invalid_argument&) {
-    if (chapter.variant_of.empty()) throw;
-  }
-  const auto original = find_chapter(chapter.variant_of).make(scene, SolverSettings{});
-  State state = rest_state(scene);
-  original->step(state);
-  return count_work(*original, scene, iterations, counted_as);
+// The counters over `steps` steps, per step.
+ExecutedWork per_step(ExecutedWork e, int steps) {
+  const double n = std::max(steps, 1);
+  e.steps /= n;
+  e.rotations /= n;
+  e.rotation_iterations /= n;
+  e.rotation_fallbacks /= n;
+  e.regions /= n;
+  e.barriers /= n;
+  return e;  // the team is the last step's
 }
 
 // The stepper at the roofs' thread count: `warmup` steps, then `steps` measured.
-ChapterRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& scene,
-                   const Roofs& roofs, int warmup, int steps) {
+PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& scene,
+                  const Roofs& roofs, int warmup, int steps) {
   const ThreadCountScope team(roofs.threads);
-  ChapterRun run;
+  PlacedRun run;
   run.mesh = mesh_name(scene);
   run.chapter = chapter.id;
   run.nodes = scene.mesh.num_nodes();
@@ -46,10 +44,21 @@ ChapterRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sc
   run.threads = roofs.threads;
   State state = rest_state(scene);
   std::vector<StepProfile> profiles;
+  const auto executed = [&] {
+    return chapter.work.executed ? chapter.work.executed(stepper) : ExecutedWork{};
+  };
+  ExecutedWork before;
   for (int k = 0; k < warmup + steps; ++k) {
+    if (k == warmup) before = executed();
     stepper.step(state);
-    if (k >= warmup) profiles.push_back(stepper.profile());
+    if (k < warmup) continue;
+    profiles.push_back(stepper.profile());
+    const int team = static_cast<int>(executed().team);
+    run.team_min = k == warmup ? team : std::min(run.team_min, team);
+    run.team_max = std::max(run.team_max, team);
   }
+  run.executed = per_step(executed().since(before), steps);
+  run.waiting_s = run.executed.regions * roofs.region_s + run.executed.barriers * roofs.barrier_s;
   std::vector<double> iterations, step;
   for (const StepProfile& p : profiles) {
     iterations.push_back(p.cg_iterations);
@@ -57,13 +66,18 @@ ChapterRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sc
   }
   run.iterations = median(iterations);
   run.step_s = median(step);
+  if (!chapter.work.count) return run;  // measured, not counted
   const std::vector<PhaseWork> work =
-      counted_work(chapter, stepper, scene, static_cast<int>(run.iterations), run.counted_as);
+      chapter.work.count(stepper, scene, WorkCounts{run.iterations, run.executed});
   for (const PhaseWork& w : work) {
     std::vector<double> seconds;
     for (const StepProfile& p : profiles) seconds.push_back(phase_seconds(p, w.phase));
-    const PhasePoint point{w, fitting_level(roofs, w.working_set).level.name,
-                           bound_seconds(roofs, w), median(seconds)};
+    const PhasePoint point{w,
+                           fitting_level(roofs, w.working_set).level.name,
+                           bound_seconds(roofs, w),
+                           memory_seconds(roofs, w),
+                           arithmetic_seconds(roofs, w),
+                           median(seconds)};
     run.bound_s += point.bound_s;
     run.phases.push_back(point);
   }
@@ -72,11 +86,11 @@ ChapterRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sc
 
 }  // namespace
 
-std::vector<ChapterRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,
-                                      const std::vector<Roofs>& roofs, int warmup, int steps) {
+std::vector<PlacedRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,
+                                     const std::vector<Roofs>& roofs, int warmup, int steps) {
   progress("roofline: " + chapter.id + " on " + mesh_name(scene));
   const auto stepper = chapter.make(scene, SolverSettings{});
-  std::vector<ChapterRun> runs;
+  std::vector<PlacedRun> runs;
   for (const Roofs& r : roofs)
     if (r.threads == 1 || stepper->uses_threads())
       runs.push_back(measure(chapter, *stepper, scene, r, warmup, steps));

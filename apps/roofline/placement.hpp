@@ -6,31 +6,39 @@
 #include <vector>
 
 #include "apps/roofline/roofs.hpp"
-#include "apps/roofline/work.hpp"
 #include "chapters/registry.hpp"
+#include "chapters/work.hpp"
 
 namespace fem::roofline {
 
 struct PhasePoint {
   PhaseWork work;
-  std::string level;        // where its working set fits: "L1", ..., "memory"
-  double bound_s = 0.0;     // bound_seconds
-  double measured_s = 0.0;  // the median of the measured steps
+  std::string level;          // where its working set fits: "L1", ..., "memory"
+  double bound_s = 0.0;       // bound_seconds: the longer of the two below
+  double memory_s = 0.0;      // its bytes at the roofs of its level
+  double arithmetic_s = 0.0;  // its flops at the peaks
+  double measured_s = 0.0;    // the median of the measured steps
 };
 
-struct ChapterRun {
-  std::string mesh, chapter, counted_as;
+// One chapter at one thread count under the roofs.
+struct PlacedRun {
+  std::string mesh, chapter;
   int nodes = 0, tets = 0, threads = 1;
   double iterations = 0.0;  // median CG iterations
+  ExecutedWork executed;    // what the stepper's counters say ran, per measured step
+  int team_min = 0,
+      team_max = 0;  // threads the measured steps ran on (0: the stepper does not say)
   std::vector<PhasePoint> phases;
-  double step_s = 0.0;   // median step
-  double bound_s = 0.0;  // sum of the phases' bounds
+  double step_s = 0.0;     // median step
+  double bound_s = 0.0;    // sum of the phases' bounds
+  double waiting_s = 0.0;  // the step's regions and barriers at their measured costs
 };
 
 // `chapter` on `scene` under each of `roofs` (one per thread count; a chapter that does not
 // use threads only under the one-thread roofs): `warmup` steps, then `steps` measured, medians
-// per phase. The same stepper at each count, in the order given.
-std::vector<ChapterRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,
-                                      const std::vector<Roofs>& roofs, int warmup, int steps);
+// per phase, its work counted by the chapter's own hook (ChapterInfo::work; a chapter without
+// one is measured and not counted). The same stepper at each count, in the order given.
+std::vector<PlacedRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,
+                                     const std::vector<Roofs>& roofs, int warmup, int steps);
 
 }  // namespace fem::roofline

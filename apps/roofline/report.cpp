@@ -3,19 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "common/json.hpp"
+#include "common/lesson.hpp"
 
 namespace fem::roofline {
 
 namespace {
-
-std::string fixed(double v, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << v;
-  return out.str();
-}
 
 // Three significant digits, as the other lessons print times.
 std::string sig(double v) {
@@ -29,22 +24,36 @@ std::string size(std::size_t bytes) {
   return sig(double(bytes) / 1024) + " KiB";
 }
 
-std::string run_name(const ChapterRun& r) {
+std::string run_name(const PlacedRun& r) {
   return "`" + r.chapter + "@" + std::to_string(r.threads) + "`";
 }
 
 // The phase whose measured time is furthest above its bound.
-const PhasePoint& widest_gap(const ChapterRun& r) {
+const PhasePoint& widest_gap(const PlacedRun& r) {
   return *std::max_element(r.phases.begin(), r.phases.end(), [](const auto& a, const auto& b) {
     return a.measured_s - a.bound_s < b.measured_s - b.bound_s;
   });
 }
 
-// Six significant digits for the JSON: the plot and the tests read them back.
-std::string num(double v) {
-  std::ostringstream out;
-  out << std::setprecision(6) << v;
-  return out.str();
+// The threads the measured steps ran on: "2", "1-2" where the adaptive team changed, the
+// roofs' count where the stepper does not say.
+std::string threads_ran(const PlacedRun& r) {
+  if (r.team_max == 0) return std::to_string(r.threads);
+  if (r.team_min == r.team_max) return std::to_string(r.team_max);
+  return std::to_string(r.team_min) + "-" + std::to_string(r.team_max);
+}
+
+// Regions and barriers per step: "12 + 340".
+std::string syncs(const PlacedRun& r) {
+  if (r.executed.regions + r.executed.barriers <= 0) return "-";
+  return sig(r.executed.regions) + " + " + sig(r.executed.barriers);
+}
+
+double of_bound(const PhasePoint& p) { return p.bound_s / std::max(p.measured_s, 1e-12); }
+
+// Which roof the bound is: the bytes' time or the flops'.
+std::string held_by(const PhasePoint& p) {
+  return p.memory_s >= p.arithmetic_s ? "bytes" : "flops";
 }
 
 }  // namespace
@@ -57,15 +66,17 @@ std::string roofs_table(const std::vector<Roofs>& roofs) {
   for (std::size_t k = 0; k < roofs.size(); ++k) out << " ---: |";
   out << " ---: | ---: |\n";
   for (std::size_t l = 0; l < roofs.front().levels.size(); ++l) {
-    out << "| " << roofs.front().levels[l].level.name << " read, GB/s | "
-        << size(roofs.front().levels[l].level.working_set) << " |";
-    std::string check, triad;
-    for (const Roofs& r : roofs) {
-      out << " " << fixed(r.levels[l].read / 1e9, 1) << " |";
-      check += (check.empty() ? "" : " / ") + fixed(r.levels[l].eigen_sum / 1e9, 1);
-      triad += (triad.empty() ? "" : " / ") + fixed(r.levels[l].triad / 1e9, 1);
+    for (const bool read : {true, false}) {
+      out << "| " << roofs.front().levels[l].level.name << (read ? " read" : " write")
+          << ", GB/s | " << size(roofs.front().levels[l].level.working_set) << " |";
+      std::string check, triad;
+      for (const Roofs& r : roofs) {
+        out << " " << fixed((read ? r.levels[l].read : r.levels[l].write) / 1e9, 1) << " |";
+        check += (check.empty() ? "" : " / ") + fixed(r.levels[l].eigen_sum / 1e9, 1);
+        triad += (triad.empty() ? "" : " / ") + fixed(r.levels[l].triad / 1e9, 1);
+      }
+      out << " " << (read ? check : "") << " | " << (read ? triad : "") << " |\n";
     }
-    out << " " << check << " | " << triad << " |\n";
   }
   for (const bool is_double : {true, false}) {
     out << "| peak multiply-add, " << (is_double ? "double" : "float") << ", Gflop/s | |";
@@ -73,6 +84,48 @@ std::string roofs_table(const std::vector<Roofs>& roofs) {
       out << " " << fixed((is_double ? r.peak_double : r.peak_float) / 1e9, 1) << " |";
     out << " | |\n";
   }
+  return out.str();
+}
+
+namespace {
+
+// Ours over likwid-bench's, or why there is no likwid number.
+std::string against(double ours, const LikwidRate& likwid) {
+  if (likwid.rate <= 0.0) return likwid.note.empty() ? "not run" : likwid.note;
+  return fixed(likwid.rate / 1e9, 1) + " (ours " + fixed(100 * ours / likwid.rate, 0) + "%)";
+}
+
+nlohmann::json likwid_json(const LikwidRate& r) {
+  return {{"kernel", r.kernel}, {"rate", r.rate}, {"note", r.note}};
+}
+
+}  // namespace
+
+std::string roofs_checked(const std::vector<Roofs>& roofs) {
+  std::ostringstream out;
+  out << "| roof | threads | ours | likwid-bench (ours in % of it) | the core's limit |\n"
+         "| --- | ---: | ---: | --- | ---: |\n";
+  for (const Roofs& r : roofs) {
+    for (const LevelRoof& l : r.levels) {
+      const bool l1 = &l == &r.levels.front();
+      out << "| " << l.level.name << " read, GB/s | " << r.threads << " | "
+          << fixed(l.read / 1e9, 1) << " | " << against(l.read, l.likwid_read) << " | "
+          << (l1 ? fixed(r.core_loads / 1e9, 1) : "") << " |\n";
+      out << "| " << l.level.name << " write, GB/s | " << r.threads << " | "
+          << fixed(l.write / 1e9, 1) << " | " << against(l.write, l.likwid_write) << " | |\n";
+    }
+    out << "| one barrier, one parallel region, us | " << r.threads << " | "
+        << fixed(1e6 * r.barrier_s, 2) << ", " << fixed(1e6 * r.region_s, 2) << " | | |\n";
+    out << "| peak multiply-add, double, Gflop/s | " << r.threads << " | "
+        << fixed(r.peak_double / 1e9, 1) << " | " << against(r.peak_double, r.likwid_peak) << " | "
+        << fixed(r.core_flops / 1e9, 1) << " |\n";
+  }
+  out << "\nThe core's limit: " << kLoadsPerCycle << " packet loads (L1) or " << kFmasPerCycle
+      << " packet multiply-adds per cycle per thread at the clock measured on the spot (";
+  for (const Roofs& r : roofs)
+    out << (&r == &roofs.front() ? "" : ", ") << fixed(r.clock / 1e9, 2) << " GHz at " << r.threads
+        << " thread(s)";
+  out << ", a chain of dependent additions).\n";
   return out.str();
 }
 
@@ -90,74 +143,120 @@ std::string roofs_check(const std::vector<Roofs>& roofs) {
   return text + "\n";
 }
 
-std::string chapters_table(const std::vector<ChapterRun>& runs) {
+std::string chapters_table(const std::vector<PlacedRun>& runs) {
   std::ostringstream out;
-  out << "| chapter | mesh | CG it. | step, ms | the roofs allow, ms | of the bound | the phase "
-         "furthest above its roof |\n| --- | --- | ---: | ---: | ---: | ---: | --- |\n";
-  for (const ChapterRun& r : runs) {
+  out << "| chapter | mesh | threads ran | CG it. | Newton it. per element | step, ms | the roofs "
+         "allow, ms | of the bound | syncs per step | waiting, ms | the phase furthest above its "
+         "roof |\n| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n";
+  for (const PlacedRun& r : runs) {
+    const double newton =
+        r.executed.rotations > 0 ? r.executed.rotation_iterations / r.executed.rotations : 0.0;
+    out << "| " << run_name(r) << " | " << r.mesh << " | " << threads_ran(r) << " | "
+        << sig(r.iterations) << " | " << (newton > 0 ? fixed(newton, 2) : "-") << " | "
+        << sig(1e3 * r.step_s) << " | ";
+    if (r.phases.empty()) {
+      out << "not counted | | | | |\n";
+      continue;
+    }
     const PhasePoint& gap = widest_gap(r);
-    out << "| " << run_name(r) << " | " << r.mesh << " | " << sig(r.iterations) << " | "
-        << sig(1e3 * r.step_s) << " | " << sig(1e3 * r.bound_s) << " | "
-        << fixed(100 * r.bound_s / r.step_s, 0) << "% | " << gap.work.phase << " ("
+    out << sig(1e3 * r.bound_s) << " | " << fixed(100 * r.bound_s / r.step_s, 0) << "% | "
+        << syncs(r) << " | " << sig(1e3 * r.waiting_s) << " | " << gap.work.phase << " ("
         << sig(1e3 * (gap.measured_s - gap.bound_s)) << " ms above) |\n";
   }
   return out.str();
 }
 
-std::string phases_table(const std::vector<ChapterRun>& runs) {
+std::string phases_table(const std::vector<PlacedRun>& runs) {
   std::ostringstream out;
-  out << "| chapter | phase | MB | Mflop | flop/byte | working set (fits) | the roofs allow, ms | "
-         "measured, ms | of the bound |\n| --- | --- | ---: | ---: | ---: | --- | ---: | ---: | "
-         "---: |\n";
-  for (const ChapterRun& r : runs)
+  out << "| chapter | phase | MB read | MB written (+ allocated) | Mflop | flop/byte | working set "
+         "(fits) | the roofs allow, ms | held by | measured, ms | of the bound |\n| --- | --- | "
+         "---: | ---: | ---: | ---: | --- | ---: | --- | ---: | ---: |\n";
+  for (const PlacedRun& r : runs)
     for (const PhasePoint& p : r.phases) {
       const double flops = p.work.flops_double + p.work.flops_float;
-      out << "| " << run_name(r) << " | " << p.work.phase << " | " << sig(p.work.bytes / 1e6)
-          << " | " << sig(flops / 1e6) << " | " << sig(flops / p.work.bytes) << " | "
+      const double ratio = of_bound(p);
+      out << "| " << run_name(r) << " | " << p.work.phase << " | " << sig(p.work.bytes_read / 1e6)
+          << " | " << sig(p.work.bytes_written / 1e6) << " (+ " << sig(p.work.bytes_allocated / 1e6)
+          << ") | " << sig(flops / 1e6) << " | " << sig(flops / p.work.bytes()) << " | "
           << size(std::size_t(p.work.working_set)) << " (" << p.level << ") | "
-          << sig(1e3 * p.bound_s) << " | " << sig(1e3 * p.measured_s) << " | "
-          << fixed(100 * p.bound_s / std::max(p.measured_s, 1e-12), 0) << "% |\n";
+          << sig(1e3 * p.bound_s) << " | " << held_by(p) << " | " << sig(1e3 * p.measured_s)
+          << " | " << fixed(100 * ratio, 0)
+          << (ratio > 1.0 ? "% **(above the bound: a broken model)**" : "%") << " |\n";
     }
   return out.str();
 }
 
-std::string json_data(const std::vector<Roofs>& roofs, const std::vector<ChapterRun>& runs) {
-  std::ostringstream out;
-  out << "{\"roofs\": [";
-  for (std::size_t k = 0; k < roofs.size(); ++k) {
-    const Roofs& r = roofs[k];
-    out << (k ? ", " : "") << "{\"threads\": " << r.threads
-        << ", \"peak_double\": " << num(r.peak_double) << ", \"peak_float\": " << num(r.peak_float)
-        << ", \"levels\": [";
-    for (std::size_t l = 0; l < r.levels.size(); ++l)
-      out << (l ? ", " : "") << "{\"name\": " << json_string(r.levels[l].level.name)
-          << ", \"working_set\": " << r.levels[l].level.working_set
-          << ", \"read\": " << num(r.levels[l].read)
-          << ", \"eigen_sum\": " << num(r.levels[l].eigen_sum)
-          << ", \"triad\": " << num(r.levels[l].triad) << "}";
-    out << "]}";
+std::string broken_bounds(const std::vector<PlacedRun>& runs) {
+  std::string names;
+  for (const PlacedRun& r : runs)
+    for (const PhasePoint& p : r.phases)
+      if (of_bound(p) > 1.0)
+        names += (names.empty() ? "" : ", ") + run_name(r) + " " + p.work.phase;
+  if (names.empty()) return "";
+  return "\n**A phase ran faster than its bound allows: " + names +
+         ". The bound is not a bound there: a count too high, a roof too low (measured on a busy "
+         "machine?), or a level too far out.**\n";
+}
+
+std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs,
+                      const std::string& provisional) {
+  nlohmann::json data = {{"roofs", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
+  if (!provisional.empty()) data["provisional"] = provisional;
+  for (const Roofs& r : roofs) {
+    nlohmann::json levels = nlohmann::json::array();
+    for (const LevelRoof& l : r.levels)
+      levels.push_back({{"name", l.level.name},
+                        {"working_set", l.level.working_set},
+                        {"read", l.read},
+                        {"write", l.write},
+                        {"eigen_sum", l.eigen_sum},
+                        {"triad", l.triad},
+                        {"likwid_read", likwid_json(l.likwid_read)},
+                        {"likwid_write", likwid_json(l.likwid_write)}});
+    data["roofs"].push_back({{"threads", r.threads},
+                             {"peak_double", r.peak_double},
+                             {"peak_float", r.peak_float},
+                             {"likwid_peak", likwid_json(r.likwid_peak)},
+                             {"clock", r.clock},
+                             {"core_loads", r.core_loads},
+                             {"core_flops", r.core_flops},
+                             {"barrier_s", r.barrier_s},
+                             {"region_s", r.region_s},
+                             {"levels", levels}});
   }
-  out << "], \"runs\": [";
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const ChapterRun& r = runs[k];
-    out << (k ? ", " : "") << "{\"chapter\": " << json_string(r.chapter)
-        << ", \"mesh\": " << json_string(r.mesh) << ", \"threads\": " << r.threads
-        << ", \"nodes\": " << r.nodes << ", \"iterations\": " << num(r.iterations)
-        << ", \"step_s\": " << num(r.step_s) << ", \"bound_s\": " << num(r.bound_s)
-        << ", \"phases\": [";
-    for (std::size_t p = 0; p < r.phases.size(); ++p) {
-      const PhasePoint& q = r.phases[p];
-      out << (p ? ", " : "") << "{\"phase\": " << json_string(q.work.phase)
-          << ", \"bytes\": " << num(q.work.bytes)
-          << ", \"flops_double\": " << num(q.work.flops_double)
-          << ", \"flops_float\": " << num(q.work.flops_float)
-          << ", \"working_set\": " << num(q.work.working_set)
-          << ", \"level\": " << json_string(q.level) << ", \"bound_s\": " << num(q.bound_s)
-          << ", \"measured_s\": " << num(q.measured_s) << "}";
-    }
-    out << "]}";
+  for (const PlacedRun& r : runs) {
+    nlohmann::json phases = nlohmann::json::array();
+    for (const PhasePoint& q : r.phases)
+      phases.push_back({{"phase", q.work.phase},
+                        {"bytes_read", q.work.bytes_read},
+                        {"bytes_written", q.work.bytes_written},
+                        {"bytes_allocated", q.work.bytes_allocated},
+                        {"flops_double", q.work.flops_double},
+                        {"flops_float", q.work.flops_float},
+                        {"working_set", q.work.working_set},
+                        {"level", q.level},
+                        {"bound_s", q.bound_s},
+                        {"memory_s", q.memory_s},
+                        {"arithmetic_s", q.arithmetic_s},
+                        {"measured_s", q.measured_s}});
+    data["runs"].push_back({{"chapter", r.chapter},
+                            {"mesh", r.mesh},
+                            {"threads", r.threads},
+                            {"team_min", r.team_min},
+                            {"team_max", r.team_max},
+                            {"nodes", r.nodes},
+                            {"iterations", r.iterations},
+                            {"rotations", r.executed.rotations},
+                            {"rotation_iterations", r.executed.rotation_iterations},
+                            {"rotation_fallbacks", r.executed.rotation_fallbacks},
+                            {"step_s", r.step_s},
+                            {"bound_s", r.bound_s},
+                            {"regions", r.executed.regions},
+                            {"barriers", r.executed.barriers},
+                            {"waiting_s", r.waiting_s},
+                            {"phases", phases}});
   }
-  return out.str() + "]}";
+  return data.dump();
 }
 
 }  // namespace fem::roofline

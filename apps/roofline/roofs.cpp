@@ -2,24 +2,38 @@
 
 #include <algorithm>
 
+#include "apps/roofline/sync_cost.hpp"
 #include "common/lesson.hpp"
 
 namespace fem::roofline {
 
-Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds) {
+Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
+                    bool likwid) {
   Roofs roofs;
   roofs.threads = threads;
   for (const MemoryLevel& level : memory_levels(caches, threads)) {
     progress("roofline: " + level.name + " bandwidth at " + std::to_string(threads) + " thread(s)");
-    LevelRoof roof{level, 0.0, 0.0, 0.0};
+    LevelRoof roof;
+    roof.level = level;
     roof.read = read_bandwidth(level.working_set, threads, seconds);
+    roof.write = write_bandwidth(level.working_set, threads, seconds);
     roof.eigen_sum = eigen_sum_bandwidth(level.working_set, threads, seconds);
     // Three arrays in the same working set as the read's one.
     roof.triad = triad_bandwidth(level.working_set / 3, threads, seconds);
+    if (likwid) {
+      roof.likwid_read = likwid_bench(LikwidKernel::load, level.working_set, threads, seconds);
+      roof.likwid_write = likwid_bench(LikwidKernel::store, level.working_set, threads, seconds);
+    }
     roofs.levels.push_back(roof);
   }
   roofs.peak_double = peak_flops_double(threads, seconds);
   roofs.peak_float = peak_flops_float(threads, seconds);
+  if (likwid) roofs.likwid_peak = likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds);
+  roofs.clock = measured_clock();
+  roofs.barrier_s = barrier_seconds(threads);
+  roofs.region_s = region_seconds(threads);
+  roofs.core_loads = kLoadsPerCycle * double_lanes() * 8.0 * roofs.clock * threads;
+  roofs.core_flops = kFmasPerCycle * double_lanes() * 2.0 * roofs.clock * threads;
   return roofs;
 }
 
@@ -30,11 +44,17 @@ const LevelRoof& fitting_level(const Roofs& roofs, double working_set) {
   return roofs.levels.back();
 }
 
+double memory_seconds(const Roofs& roofs, const PhaseWork& work) {
+  const LevelRoof& level = fitting_level(roofs, work.working_set);
+  return work.bytes_read / level.read + work.bytes_written / level.write;
+}
+
+double arithmetic_seconds(const Roofs& roofs, const PhaseWork& work) {
+  return work.flops_double / roofs.peak_double + work.flops_float / roofs.peak_float;
+}
+
 double bound_seconds(const Roofs& roofs, const PhaseWork& work) {
-  const double memory = work.bytes / fitting_level(roofs, work.working_set).read;
-  const double arithmetic =
-      work.flops_double / roofs.peak_double + work.flops_float / roofs.peak_float;
-  return std::max(memory, arithmetic);
+  return std::max(memory_seconds(roofs, work), arithmetic_seconds(roofs, work));
 }
 
 }  // namespace fem::roofline

@@ -5,32 +5,52 @@
 #include <vector>
 
 #include "apps/roofline/bandwidth.hpp"
+#include "apps/roofline/likwid.hpp"
 #include "apps/roofline/peak.hpp"
-#include "apps/roofline/work.hpp"
+#include "chapters/work.hpp"
 
 namespace fem::roofline {
 
 struct LevelRoof {
   MemoryLevel level;
-  double read = 0.0;       // bytes/s: the roof (read_bandwidth)
-  double eigen_sum = 0.0;  // bytes/s: the second measurement (eigen_sum_bandwidth)
-  double triad = 0.0;      // bytes/s: STREAM's triad as STREAM counts it
+  double read = 0.0;                     // bytes/s: the roof (read_bandwidth)
+  double write = 0.0;                    // bytes/s: the write roof (write_bandwidth)
+  double eigen_sum = 0.0;                // bytes/s: the second measurement (eigen_sum_bandwidth)
+  double triad = 0.0;                    // bytes/s: STREAM's triad as STREAM counts it
+  LikwidRate likwid_read, likwid_write;  // likwid-bench's load and store at the same sizes
 };
 
 struct Roofs {
   int threads = 1;
   std::vector<LevelRoof> levels;               // innermost first, memory last
   double peak_double = 0.0, peak_float = 0.0;  // flops/s
+  LikwidRate likwid_peak;                      // likwid-bench's double multiply-add peak
+  double clock = 0.0;                          // cycles/s, measured_clock()
+  // The cores' own limits at that clock: kLoadsPerCycle packet loads and kFmasPerCycle packet
+  // multiply-adds per cycle per thread.
+  double core_loads = 0.0, core_flops = 0.0;  // bytes/s, flops/s
+  double barrier_s = 0.0, region_s = 0.0;     // one barrier, one parallel region (sync_cost)
 };
 
-// Every roof at `threads` threads, each kernel run for about `seconds`.
-Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds);
+// Two loads and two multiply-adds issued per cycle: the x86 cores since Haswell and Zen 2
+// (Intel's and AMD's optimization manuals); a core with fewer is below its limit, not over.
+constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
+
+// Every roof at `threads` threads, each kernel run for about `seconds`, with likwid-bench's
+// at the same sizes where `likwid` (and where it is installed).
+Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
+                    bool likwid);
 
 // The innermost level whose share per thread holds the working set (memory if none).
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
-// The time the roofs allow a phase: its bytes at the bandwidth of the level its working set
-// fits, or its flops at the peak (double and float flops each at their own), the longer.
+// The time the roofs allow a phase: its bytes read at the read roof and its bytes written at
+// the write roof of the level its working set fits (the write roof's stores allocate their
+// lines as the phase's do), or its flops at the peak (double and float flops each at their
+// own), the longer.
 double bound_seconds(const Roofs& roofs, const PhaseWork& work);
+// Its two parts: the bytes' time and the flops' time.
+double memory_seconds(const Roofs& roofs, const PhaseWork& work);
+double arithmetic_seconds(const Roofs& roofs, const PhaseWork& work);
 
 }  // namespace fem::roofline

@@ -31,78 +31,82 @@ double spring_stiffness(double body_weight_per_diagonal, double relative_stiffne
 
 Session::Session(TetMesh mesh, const SessionSettings& settings, const std::string& chapter)
     : settings_(settings),
-      scene_(build_scene(settings, std::move(mesh))),
-      chapter_(find_chapter(chapter).id) {
-  rebuild_stepper();
-  state_ = rest_state(scene_);
+      body_(build_scene(settings, std::move(mesh)), settings.solver, find_chapter(chapter).id),
+      chapter_(body_.chapter()) {
+  measure_body();
 }
 
-void Session::rebuild_stepper() {
-  const Model model(scene_);
+void Session::measure_body() {
+  const Scene& scene = body_.scene();
+  const Model model(scene);
   node_mass_.resize(model.num_nodes);
   for (int i = 0; i < model.num_nodes; ++i) node_mass_[i] = model.lumped_mass[3 * i];
-  const Eigen::Vector3d lo = scene_.mesh.X.rowwise().minCoeff();
-  const Eigen::Vector3d hi = scene_.mesh.X.rowwise().maxCoeff();
+  const Eigen::Vector3d lo = scene.mesh.X.rowwise().minCoeff();
+  const Eigen::Vector3d hi = scene.mesh.X.rowwise().maxCoeff();
   diagonal_ = (hi - lo).norm();
-  weight_per_diagonal_ = node_mass_.sum() * scene_.gravity.norm() / diagonal_;
-  stepper_ = make_stepper(chapter_, scene_, settings_.solver);
-  history_.clear();
+  weight_per_diagonal_ = node_mass_.sum() * scene.gravity.norm() / diagonal_;
 }
 
 void Session::set_chapter(const std::string& chapter) {
-  chapter_ = find_chapter(chapter).id;
-  stepper_ = make_stepper(chapter_, scene_, settings_.solver);
+  body_.set_chapter(chapter);  // the state carries over
+  chapter_ = body_.chapter();
   history_.clear();
 }
 
 void Session::apply(const SessionSettings& settings) {
   const bool restart = settings.scene != settings_.scene;
-  Scene scene = build_scene(settings, scene_.mesh);  // throws before anything changes
+  // Throws before anything changes.
+  femcourse::Body next(build_scene(settings, body_.scene().mesh), settings.solver, chapter_);
+  next.set_state(body_.state());
   settings_ = settings;
-  scene_ = std::move(scene);
-  rebuild_stepper();
+  body_ = std::move(next);
+  measure_body();
+  history_.clear();
   if (restart) reset();
 }
 
 void Session::reset() {
-  state_ = rest_state(scene_);
+  body_ = femcourse::Body(body_.scene(), settings_.solver, chapter_);  // forgets the warm start
   time_ = 0.0;
   steps_ = 0;
   grab_.reset();
   history_.clear();
-  stepper_ = make_stepper(chapter_, scene_, settings_.solver);  // forgets the warm start
 }
 
 bool Session::step() {
   // The scene's own interaction forces, plus the spring: both are the sparse f_ext.
-  forces_ = scene_.external_forces;
-  const std::vector<ExternalForce> spring = spring_forces();
-  forces_.insert(forces_.end(), spring.begin(), spring.end());
-  stepper_->set_external_forces(forces_);
-  stepper_->step(state_);
-  if (const char* why = divergence(state_, stepper_->profile())) {
-    message_ = "the simulation diverged at t = " + std::to_string(time_) + " s (" + why +
+  forces_.clear();
+  for (const ExternalForce& f : body_.scene().external_forces)
+    forces_.push_back({f.node, {f.force.x(), f.force.y(), f.force.z()}});
+  for (const ExternalForce& f : spring_forces())
+    forces_.push_back({f.node, {f.force.x(), f.force.y(), f.force.z()}});
+  body_.set_forces(forces_);
+  try {
+    body_.step();
+  } catch (const femcourse::StepDiverged& e) {
+    message_ = "the simulation diverged at t = " + std::to_string(time_) + " s (" + e.reason +
                ") and was reset: try a smaller dt, a softer spring or more damping";
     reset();
     return false;
   }
-  time_ += scene_.dt;
+  time_ += body_.scene().dt;
   ++steps_;
-  history_.push_back(stepper_->profile());
+  history_.push_back(body_.stepper().profile());
   if (history_.size() > kHistory) history_.pop_front();
   return true;
 }
 
 void Session::grab(int node, const Eigen::Vector3d& target) {
-  if (node < 0 || node >= scene_.mesh.num_nodes())
+  const Scene& scene = body_.scene();
+  if (node < 0 || node >= scene.mesh.num_nodes())
     throw std::invalid_argument("grab: node " + std::to_string(node) + " is not in the mesh");
   if (!target.allFinite()) throw std::invalid_argument("grab: the target is not finite");
   grab_ = Grab{node, target};
   patch_.clear();
   patch_mass_ = 0.0;
-  const Eigen::Vector3d centre = scene_.mesh.X.col(node);
-  for (int j = 0; j < scene_.mesh.num_nodes(); ++j) {
-    if ((scene_.mesh.X.col(j) - centre).norm() > kGrabRadius * diagonal_) continue;
+  const Eigen::Vector3d centre = scene.mesh.X.col(node);
+  for (int j = 0; j < scene.mesh.num_nodes(); ++j) {
+    if ((scene.mesh.X.col(j) - centre).norm() > kGrabRadius * diagonal_) continue;
     patch_.push_back(j);  // the grabbed node itself is always in
     patch_mass_ += node_mass_[j];
   }
@@ -116,9 +120,11 @@ void Session::release() { grab_.reset(); }
 
 std::vector<ExternalForce> Session::spring_forces() const {
   if (!grab_) return {};
-  const double k = spring_stiffness(weight_per_diagonal_, settings_.spring, patch_mass_, scene_.dt);
+  const Scene& scene = body_.scene();
+  const State& state = body_.state();
+  const double k = spring_stiffness(weight_per_diagonal_, settings_.spring, patch_mass_, scene.dt);
   const Eigen::Vector3d stretch =
-      grab_->target - state_.x.segment<3>(3 * static_cast<Eigen::Index>(grab_->node));
+      grab_->target - state.x.segment<3>(3 * static_cast<Eigen::Index>(grab_->node));
   const double length = stretch.stableNorm();  // norm() would square 1e300 into infinity
   const double longest = kMaxPull * diagonal_;
   const Eigen::Vector3d pull = k * (length > longest ? (longest / length) * stretch : stretch);

@@ -12,6 +12,7 @@
 
 #include "common/scene.hpp"
 #include "common/stepper.hpp"
+#include "femcourse/simulator.hpp"
 
 namespace fem::viewer {
 
@@ -67,12 +68,12 @@ class Session {
   void release();
   const std::optional<Grab>& grabbed() const { return grab_; }
 
-  const Scene& scene() const { return scene_; }
-  const State& state() const { return state_; }
+  const Scene& scene() const { return body_.scene(); }
+  const State& state() const { return body_.state(); }
   const SessionSettings& settings() const { return settings_; }
   const std::string& chapter() const { return chapter_; }
-  const StepProfile& last_profile() const { return stepper_->profile(); }
-  bool uses_threads() const { return stepper_->uses_threads(); }
+  const StepProfile& last_profile() const { return body_.stepper().profile(); }
+  bool uses_threads() const { return body_.stepper().uses_threads(); }
   // The profiles of the last steps (oldest first), for averages and plots.
   const std::deque<StepProfile>& history() const { return history_; }
   StepProfile mean_profile() const;
@@ -84,20 +85,18 @@ class Session {
   std::vector<ExternalForce> spring_forces() const;
 
  private:
-  void rebuild_stepper();
+  void measure_body();
 
   SessionSettings settings_;
-  Scene scene_;
+  femcourse::Body body_;  // the scene, the chapter's stepper and the state (the library's API)
   std::string chapter_;
-  std::unique_ptr<Stepper> stepper_;
-  State state_;
   Eigen::VectorXd node_mass_;         // lumped mass per node
   double diagonal_ = 0.0;             // of the rest bounding box [m]
   double weight_per_diagonal_ = 0.0;  // [N/m]
   std::vector<int> patch_;            // the grabbed node's neighbours within kGrabRadius
   double patch_mass_ = 0.0;
   std::optional<Grab> grab_;
-  std::vector<ExternalForce> forces_;  // the scene's and the spring's, passed to the stepper
+  std::vector<femcourse::NodeForce> forces_;  // the scene's and the spring's, passed to the body
   std::deque<StepProfile> history_;
   double time_ = 0.0;
   long long steps_ = 0;

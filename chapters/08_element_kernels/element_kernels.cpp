@@ -75,9 +75,11 @@ int newton_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q) {
 }
 
 Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
-                                    long long& fallbacks) {
+                                    long long& fallbacks, int* iterations) {
   Eigen::Quaterniond start = q;
-  if (newton_polar_rotation(F, start) > 0) {
+  const int k = newton_polar_rotation(F, start);
+  if (iterations) *iterations = k > 0 ? k : 0;
+  if (k > 0) {
     q = start;
     return q.toRotationMatrix();
   }
@@ -130,7 +132,9 @@ void FusedElements::terms(int e, const Eigen::Vector4i& t, const State& state, l
     Dv.col(i) = state.v.segment<3>(3 * t[i + 1]) - state.v.segment<3>(3 * t[0]);
   }
   Eigen::Quaterniond q = predicted_rotation(rotations_[e], previous_rotations_[e]);
-  const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks);
+  int iterations = 0;
+  const Eigen::Matrix3d R = fast_polar_rotation(Ds * shape.Dm_inv, q, fallbacks, &iterations);
+  iterations_.add(iterations);
   // The first step has no angular velocity to extrapolate: the next starts from R itself.
   previous_rotations_[e] = first_step_ ? q : rotations_[e];
   rotations_[e] = q;
@@ -152,6 +156,7 @@ void FusedElements::end_pass(long long fallbacks) {
   first_step_ = false;
   last_step_fallbacks_ = fallbacks;
   total_fallbacks_ += fallbacks;
+  total_rotations_ += static_cast<long long>(shapes_.size());
 }
 
 void scatter(const Eigen::Vector4i& t, const std::array<int, 16>& blocks, const ElementTerms& terms,

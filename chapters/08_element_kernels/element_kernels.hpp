@@ -9,6 +9,10 @@
 #include <array>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "chapters/07_block_sparse/block_sparse.hpp"
 #include "common/model.hpp"
 
@@ -58,8 +62,35 @@ inline Eigen::Quaterniond predicted_rotation(const Eigen::Quaterniond& last,
 // The rotation common/'s polar_rotation returns (to 1e-12 per entry, the tests), by Newton
 // from q where it decides, and by common/'s SVD where it does not (then ++fallbacks). q
 // holds the answer on exit, the next step's warm start.
+// With `iterations`, Newton's iterations go there (0 where it did not decide).
 Eigen::Matrix3d fast_polar_rotation(const Eigen::Matrix3d& F, Eigen::Quaterniond& q,
-                                    long long& fallbacks);
+                                    long long& fallbacks, int* iterations = nullptr);
+
+// The Newton iterations an element pass ran, for the roofline's flops as executed: one count
+// per OpenMP thread number, each on its own cache line (no thread writes a line another
+// writes, so counting costs an add per element and no sharing), summed only when asked.
+class IterationCounter {
+ public:
+  void add(long long n) {
+#ifdef _OPENMP
+    slots_[omp_get_thread_num() % kSlots].n += n;
+#else
+    slots_[0].n += n;
+#endif
+  }
+  long long total() const {
+    long long sum = 0;
+    for (const Slot& s : slots_) sum += s.n;
+    return sum;
+  }
+
+ private:
+  static constexpr int kSlots = 64;  // thread numbers beyond share slots: keep teams <= 64
+  struct alignas(64) Slot {
+    long long n = 0;
+  };
+  std::array<Slot, kSlots> slots_{};
+};
 
 // The ten distinct blocks K_ab, a <= b, of K = R K0 R^T = -df/dx_e in closed form, with
 // r_a = R g_a (columns of r) and K0 never formed:
@@ -105,6 +136,9 @@ class FusedElements {
   // step, and in all steps so far.
   long long last_step_fallbacks() const { return last_step_fallbacks_; }
   long long total_fallbacks() const { return total_fallbacks_; }
+  // Rotations computed and Newton iterations run, in all steps so far.
+  long long total_rotations() const { return total_rotations_; }
+  long long total_newton_iterations() const { return iterations_.total(); }
 
  private:
   double h_ = 0.0;
@@ -114,7 +148,8 @@ class FusedElements {
   std::vector<Eigen::Quaterniond> rotations_;           // R_e of the last step
   std::vector<Eigen::Quaterniond> previous_rotations_;  // R_e of the step before
   bool first_step_ = true;
-  long long last_step_fallbacks_ = 0, total_fallbacks_ = 0;
+  long long last_step_fallbacks_ = 0, total_fallbacks_ = 0, total_rotations_ = 0;
+  IterationCounter iterations_;
 };
 
 // b += the element's terms, A += its blocks: ten computed, sixteen written (K_ba = K_ab^T),

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <vector>
 
 #ifdef _OPENMP
@@ -11,6 +12,24 @@
 #endif
 
 namespace fem::ch09 {
+
+// The synchronizations the threads have met, in all steps of every stepper so far: parallel
+// regions opened with more than one thread, and barriers (each worksharing loop's end, each
+// single's), counted once per team by its thread 0, for the roofline's cost of waiting. A
+// relaxed add from one thread per barrier: nanoseconds beside the barrier's own cost.
+struct SyncCounts {
+  std::atomic<long long> regions{0}, barriers{0};
+};
+inline SyncCounts& sync_counts() {
+  static SyncCounts counts;
+  return counts;
+}
+inline void count_barrier() {
+#ifdef _OPENMP
+  if (omp_get_thread_num() != 0) return;
+#endif
+  sync_counts().barriers.fetch_add(1, std::memory_order_relaxed);
+}
 
 // Runs body() on every thread of a team, or straight on the calling thread when the team
 // would have one thread. Why not always a region: libgomp keeps the last team for reuse
@@ -22,6 +41,7 @@ template <class Body>
 void run_parallel(Body&& body) {
 #ifdef _OPENMP
   if (omp_get_max_threads() > 1) {
+    sync_counts().regions.fetch_add(1, std::memory_order_relaxed);
 #pragma omp parallel
     body();
     return;
@@ -53,9 +73,11 @@ class StaticShare {
     begin_ = first + static_cast<int>(count * thread / threads);
     end_ = first + static_cast<int>(count * (thread + 1) / threads);
   }
-  ~StaticShare(){
+  ~StaticShare() {
+    count_barrier();
 #pragma omp barrier
-  } StaticShare(const StaticShare&) = delete;
+  }
+  StaticShare(const StaticShare&) = delete;
   StaticShare& operator=(const StaticShare&) = delete;
 
   struct Iterator {
@@ -110,6 +132,7 @@ void for_parts(const std::vector<int>& start, bool collective, Body&& body) {
 template <class Body>
 void on_one_thread(bool collective, Body&& body) {
   if (collective) {
+    count_barrier();
 #pragma omp single
     body();
   } else {

@@ -221,12 +221,15 @@ void ThreadsStepper::element_pass_colouring(const State& state) {
 
 void ThreadsStepper::solve() {
   // Warm start: y_ still holds the previous step's answer; the solver filters it.
-  const SolveStats result =
-      parallel_pcg_.solve(system_matrix(), *preconditioner_, filtered_b_, settings_, y_);
+  const SolveStats result = solve_filtered_system(y_);
   dv_ = y_;
   dv_ += z_;
   profile_.record(result);
   report_if_not_converged(profile_, settings_, chapter_, warned_not_converged_);
+}
+
+SolveStats ThreadsStepper::solve_filtered_system(Eigen::VectorXd& y) {
+  return parallel_pcg_.solve(system_matrix(), *preconditioner_, filtered_b_, settings_, y);
 }
 
 }  // namespace fem::ch09

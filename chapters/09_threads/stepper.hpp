@@ -48,6 +48,7 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // Tests that compare thread counts keep the count they set (off); the environment variable
   // FEM_ADAPTIVE_TEAM=0 turns it off for a whole program (to see what it prevents).
   AdaptiveTeam& adaptive_team() { return adaptive_team_; }
+  const AdaptiveTeam& adaptive_team() const { return adaptive_team_; }
 
  protected:
   // The PCG's preconditioner from the next step on (block Jacobi until then), and the
@@ -56,6 +57,9 @@ class ThreadsStepper : public ch08::ElementKernelsStepper {
   // The parallel PCG on the filtered system from the guess in y_ (virtual: a derived stepper
   // may prepare its preconditioner first).
   void solve() override;
+  // The filtered system's solve, y from its guess: chapter 09's parallel PCG with the
+  // preconditioner in use (virtual: a derived stepper may solve it its own way).
+  virtual SolveStats solve_filtered_system(Eigen::VectorXd& y);
   // Colours groups of `group` consecutive elements (kGroup by default): on a mesh whose
   // elements come sorted along it, long groups are slabs, and fewer colours.
   void colour_element_groups(int group);

@@ -160,15 +160,17 @@ void newton_update(const Lanes (&step)[3], const Flag (&definite)[kLanes], Newto
 }
 
 // Phase 2: Newton on every lane still iterating, its branches as selects; a lane that
-// converged or failed keeps its q.
-void newton_iterations(Newton& n) {
+// converged or failed keeps its q. Returns the iterations run.
+int newton_iterations(Newton& n) {
   Lanes step[3];
   Flag definite[kLanes];
-  for (int it = 0; it < kMaxIterations; ++it) {
+  int it = 0;
+  for (; it < kMaxIterations; ++it) {
     if (std::none_of(n.status, n.status + kLanes, [](Flag s) { return s == kIterating; })) break;
     newton_step(n, step, definite);
     newton_update(step, definite, n);
   }
+  return it;
 }
 
 // Phase 3: the converged lanes normalized (chapter 08's q.normalize()), all lanes at once: the
@@ -206,12 +208,13 @@ void finish_rotations(int count, Newton& n, Lanes (&q)[4], long long& fallbacks)
 
 }  // namespace
 
-void polar_rotations(const Lanes (&ds)[9], const Lanes (&dm)[9], const Lanes (&last)[4],
-                     const Lanes (&before)[4], int count, Lanes (&q)[4], long long& fallbacks) {
+int polar_rotations(const Lanes (&ds)[9], const Lanes (&dm)[9], const Lanes (&last)[4],
+                    const Lanes (&before)[4], int count, Lanes (&q)[4], long long& fallbacks) {
   Newton n;
   newton_start(ds, dm, last, before, n);
-  newton_iterations(n);
+  const int iterations = newton_iterations(n);
   finish_rotations(count, n, q, fallbacks);
+  return iterations;
 }
 
 }  // namespace fem::ch12

@@ -17,8 +17,9 @@ struct alignas(64) Lanes {
 // (w, x, y, z) in q, lane by lane as chapter 08 decides them: Newton from the predicted
 // rotation last * conj(before) * last within ch08::newton's limits, chapter 08's
 // fast_polar_rotation from the same start in lanes 0 .. count - 1 where Newton cannot decide
-// (++fallbacks). The lanes past count need only hold valid numbers.
-void polar_rotations(const Lanes (&ds)[9], const Lanes (&dm)[9], const Lanes (&last)[4],
-                     const Lanes (&before)[4], int count, Lanes (&q)[4], long long& fallbacks);
+// (++fallbacks). The lanes past count need only hold valid numbers. Returns the Newton
+// iterations the lanes ran together (every lane runs each one, in vector code).
+int polar_rotations(const Lanes (&ds)[9], const Lanes (&dm)[9], const Lanes (&last)[4],
+                    const Lanes (&before)[4], int count, Lanes (&q)[4], long long& fallbacks);
 
 }  // namespace fem::ch12

@@ -154,7 +154,9 @@ void BatchedElements::terms(int first, int count, const std::vector<Eigen::Vecto
   GatheredBatch g;
   gather(first, count, tets, state, g);
   Lanes q[4], r[3][4];
-  polar_rotations(g.ds, g.dm, g.last, g.before, count, q, fallbacks);
+  iterations_.add(
+      static_cast<long long>(polar_rotations(g.ds, g.dm, g.last, g.before, count, q, fallbacks)) *
+      count);
   keep_rotations(first, count, g, q);
   rotated_gradients(q, g.dm, r);
   forces(g, r, h_, velocity_scale_, out);
@@ -226,6 +228,8 @@ void BatchedElements::keep_rotations(int first, int count, const GatheredBatch& 
 void BatchedElements::end_pass(long long fallbacks) {
   first_step_ = false;
   last_step_fallbacks_ = fallbacks;
+  total_fallbacks_ += fallbacks;
+  total_rotations_ += elements_;
 }
 
 Eigen::Quaterniond BatchedElements::rotation(int e) const {

@@ -48,6 +48,11 @@ class BatchedElements {
 
   Eigen::Quaterniond rotation(int e) const;  // of the last step (tests)
   long long last_step_fallbacks() const { return last_step_fallbacks_; }
+  // In all steps so far: fallbacks, rotations computed, and Newton's iterations counted per
+  // element as the lanes ran them (a batch's iterations times its elements).
+  long long total_fallbacks() const { return total_fallbacks_; }
+  long long total_rotations() const { return total_rotations_; }
+  long long total_newton_iterations() const { return iterations_.total(); }
 
  private:
   void gather(int first, int count, const std::vector<Eigen::Vector4i>& tets, const State& state,
@@ -62,7 +67,8 @@ class BatchedElements {
   std::vector<double> mu_volume_, lambda_volume_;
   std::array<std::vector<double>, 4> rotation_, previous_;
   bool first_step_ = true;
-  long long last_step_fallbacks_ = 0;
+  long long last_step_fallbacks_ = 0, total_fallbacks_ = 0, total_rotations_ = 0;
+  ch08::IterationCounter iterations_;
 };
 
 // b += lane l's terms, A += its blocks (ten computed, sixteen written), at the element's blocks

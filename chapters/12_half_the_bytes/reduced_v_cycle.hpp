@@ -70,6 +70,10 @@ class ReducedVCycle final : public ch09::Preconditioner {
   // diagonals of every level; chapter 10's in double are twice as many.
   long long number_bytes() const;
 
+  // The float levels, for a cycle run on them in another order of loops.
+  ReducedLevel<Real, 3>& fine_level() { return fine_; }
+  std::vector<ReducedLevel<Real, kModes>>& coarse_levels() { return coarse_; }
+
  private:
   template <int B>
   void convert(ReducedLevel<Real, B>& level, bool refreshed, bool collective);

@@ -13,7 +13,7 @@
 
 namespace fem::ch12 {
 
-class HalfBytesStepper final : public ch11::NodeOrderStepper {
+class HalfBytesStepper : public ch11::NodeOrderStepper {
  public:
   // single: the V-cycle in float on float numbers (the default); double_on_float: the same
   // float numbers, widened to double in registers (the lesson measures both).

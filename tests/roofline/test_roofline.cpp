@@ -1,53 +1,76 @@
-// The roofline's counts against the data structures they count, computed here independently
-// from the stepper's objects; and the working sets of the roofs. No timing is asserted: the
-// roofs' second measurement is reported by the lesson (fem_lessons roofline), not tested.
+// The work counts (each chapter's work.hpp, through the registry's hook) against the data
+// structures they count, computed here independently from the stepper's objects; the flops
+// of the element pass against the iterations the kernel counted; and the working sets of the
+// roofs. No timing is asserted: the roofs' second measurement is reported by the lesson
+// (fem_lessons roofline), not tested.
 #include "apps/roofline/bandwidth.hpp"
-#include "apps/roofline/work.hpp"
 #include "catch2_compat.hpp"
-#include "chapters/01_naive/stepper.hpp"
-#include "chapters/07_block_sparse/stepper.hpp"
+#include "chapters/01_naive/work.hpp"
+#include "chapters/07_block_sparse/work.hpp"
+#include "chapters/08_element_kernels/work.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/report.hpp"
-#include "chapters/10_multigrid/stepper.hpp"
+#include "chapters/10_multigrid/work.hpp"
+#include "chapters/12_half_the_bytes/work.hpp"
 #include "chapters/registry.hpp"
+#include "common/threads.hpp"
 #include "support.hpp"
 
 using namespace fem;
 
 namespace {
 
-const roofline::PhaseWork& phase(const std::vector<roofline::PhaseWork>& work,
-                                 const std::string& name) {
+const PhaseWork& phase(const std::vector<PhaseWork>& work, const std::string& name) {
   for (const auto& w : work)
     if (w.phase == name) return w;
   FAIL("no phase " << name);
   return work.front();
 }
 
+// `steps` steps of `stepper` from rest, and its work counted by its chapter's hook with the
+// counters of those steps.
+std::vector<PhaseWork> stepped_work(const ChapterInfo& chapter, Stepper& stepper,
+                                    const Scene& scene, int steps) {
+  State state = rest_state(scene);
+  for (int k = 0; k < steps; ++k) stepper.step(state);
+  REQUIRE(chapter.work.count);
+  WorkCounts counts{double(stepper.profile().cg_iterations), {}};
+  if (chapter.work.executed) {
+    counts.per_step = chapter.work.executed(stepper);
+    const double n = counts.per_step.steps;
+    counts.per_step = {1.0, counts.per_step.rotations / n, counts.per_step.rotation_iterations / n,
+                       counts.per_step.rotation_fallbacks / n};
+  }
+  return chapter.work.count(stepper, scene, counts);
+}
+
 }  // namespace
 
 TEST_CASE("roofline: chapter 07's matrix bytes are its blocks and indices", "[roofline]") {
   const Scene scene = test::test_scene("cantilever");
-  ch07::BlockSparseStepper stepper(scene, {});
-  State state = rest_state(scene);
-  stepper.step(state);
-  const ch07::BlockSparseMatrix& A = stepper.system_matrix();
+  const ChapterInfo& chapter = find_chapter("07");
+  const auto stepper = chapter.make(scene, {});
+  const auto work = stepped_work(chapter, *stepper, scene, 1);
+  const auto& A =
+      dynamic_cast<const ch07::BlockSparseStepper&>(unwrapped(*stepper)).system_matrix();
   const double expected =
       double(A.blocks.size()) * 72.0 + double(A.column.size() + A.row_start.size()) * 4.0;
-  CHECK(roofline::matrix_bytes(A) == expected);
-  // The solve streams the matrix, the block-Jacobi inverses and 11 vectors per product.
-  const int it = stepper.profile().cg_iterations;
-  std::string counted_as;
-  const auto work = roofline::count_work(stepper, scene, it, counted_as);
-  CHECK(counted_as == "07");
-  const double n = 3.0 * scene.mesh.num_nodes();
-  const double per_iteration = expected + scene.mesh.num_nodes() * 72.0 + 11 * n * 8;
-  CHECK(phase(work, "solve").bytes == Approx((it + 1) * per_iteration));
-  // The constraints: the blocks of constrained rows and columns, read and written.
+  CHECK(ch07::matrix_bytes(A) == expected);
+  // The solve: per product the matrix and the block-Jacobi inverses read; 8 vectors read, 5
+  // written, 2 of them (q and z) to lines not read first.
+  const double it = stepper->profile().cg_iterations;
+  const double v = 3.0 * scene.mesh.num_nodes() * 8;
+  const double read = expected + scene.mesh.num_nodes() * 72.0 + 8 * v;
+  CHECK(phase(work, "solve").bytes_read == Approx((it + 1) * read));
+  CHECK(phase(work, "solve").bytes_written == Approx((it + 1) * 5 * v));
+  CHECK(phase(work, "solve").bytes_allocated == Approx((it + 1) * 2 * v));
+  // The constraints: the blocks of constrained rows and columns, read and written back.
   double blocks = 0;
   for (const NodeConstraint& c : scene.constraints)
     blocks += A.row_start[c.node + 1] - A.row_start[c.node];
   REQUIRE(blocks > 0);
-  CHECK(phase(work, "constraints").bytes == Approx(4 * 72 * blocks + 2 * n * 8));
+  CHECK(phase(work, "constraints").bytes_read == Approx(2 * 72 * blocks + v));
+  CHECK(phase(work, "constraints").bytes_written == Approx(2 * 72 * blocks + v));
 }
 
 TEST_CASE("roofline: chapter 01's matrix bytes are Eigen's compressed storage", "[roofline]") {
@@ -58,11 +81,83 @@ TEST_CASE("roofline: chapter 01's matrix bytes are Eigen's compressed storage", 
   const Eigen::SparseMatrix<double>& dfdx = stepper.dfdx();
   REQUIRE(dfdx.isCompressed());
   const double expected = double(dfdx.nonZeros()) * (8 + 4) + double(dfdx.cols() + 1) * 4;
-  CHECK(roofline::matrix_bytes(dfdx) == expected);
+  CHECK(ch01::matrix_bytes(dfdx) == expected);
+  // df/dx is written fresh, once per step: its bytes written are the matrix's.
+  const auto work = ch01::count_work(stepper, scene, {1.0, {}});
+  CHECK(phase(work, "dfdx").bytes_written == expected);
+  CHECK(phase(work, "dfdx").bytes_allocated == expected);
   // Every entry of df/dx is one of 3x3 blocks of the chapter 07 pattern on the same mesh.
   ch07::BlockSparseStepper blocks(scene, {});
   blocks.step(state);
   CHECK(double(dfdx.nonZeros()) == 9.0 * double(blocks.system_matrix().blocks.size()));
+}
+
+TEST_CASE("roofline: the fused pass's writes are the objects it writes", "[roofline]") {
+  const Scene scene = test::test_scene("cantilever");
+  const ChapterInfo& chapter = find_chapter("08");
+  const auto stepper = chapter.make(scene, {});
+  const auto work = stepped_work(chapter, *stepper, scene, 2);
+  const auto& s = dynamic_cast<const ch08::ElementKernelsStepper&>(unwrapped(*stepper));
+  // Both rotations of every element, every block of A and b: their sizes in memory.
+  const double rotations =
+      double(s.elements().rotations().size()) * sizeof(Eigen::Quaterniond) +
+      double(s.elements().previous_rotations().size()) * sizeof(Eigen::Quaterniond);
+  const double A = double(s.system_matrix().blocks.size()) * sizeof(Eigen::Matrix3d);
+  const double b = double(s.system_rhs().size()) * sizeof(double);
+  CHECK(phase(work, "forces").bytes_written == Approx(rotations + A + b));
+  CHECK(phase(work, "forces").bytes_allocated == 0.0);  // each line read before it is written
+  // compose zeroes A and writes b afresh.
+  CHECK(phase(work, "compose").bytes_written == Approx(A + b));
+  CHECK(phase(work, "compose").bytes_allocated == Approx(A + b));
+}
+
+TEST_CASE("roofline: the element pass's flops are the Newton iterations it counted", "[roofline]") {
+  const Scene scene = test::test_scene("cantilever");
+  for (const char* id : {"08", "12"}) {
+    const ChapterInfo& chapter = find_chapter(id);
+    const auto stepper = chapter.make(scene, {});
+    State state = rest_state(scene);
+    for (int k = 0; k < 3; ++k) stepper->step(state);
+    REQUIRE(chapter.work.executed);
+    const ExecutedWork e = chapter.work.executed(*stepper);
+    const double elements = scene.mesh.num_tets();
+    CHECK(e.steps == 3.0);
+    CHECK(e.rotations == 3.0 * elements);
+    // Newton from the predicted rotation: at least one iteration per rotation it decided.
+    CHECK(e.rotation_iterations >= e.rotations - e.rotation_fallbacks);
+    CHECK(e.rotation_iterations <= e.rotations * ch08::newton::kMaxIterations);
+    const WorkCounts counts{
+        1.0, {1.0, e.rotations / 3, e.rotation_iterations / 3, e.rotation_fallbacks / 3}};
+    const auto work = chapter.work.count(*stepper, scene, counts);
+    const double expected = elements * ch08::fused_element_flops() +
+                            e.rotation_iterations / 3 * ch08::newton_iteration_flops() +
+                            e.rotations / 3 * ch08::newton_finish_flops();
+    CHECK(phase(work, "forces").flops_double == Approx(expected));
+  }
+}
+
+TEST_CASE("roofline: a chapter is counted from its own data, not its base's", "[roofline]") {
+  // Chapter 12 derives from 11 and keeps the V-cycle's levels in float: its own count (its
+  // work.hpp, found for its class) moves fewer bytes in the solve than 11's, whose count is
+  // chapter 10's (11 adds no data), on the same hierarchy.
+  const Scene scene = test::test_scene("cantilever");
+  const ChapterInfo& c11 = find_chapter("11");
+  const ChapterInfo& c12 = find_chapter("12");
+  const auto s11 = c11.make(scene, {}), s12 = c12.make(scene, {});
+  const auto w11 = stepped_work(c11, *s11, scene, 1);
+  const auto w12 = stepped_work(c12, *s12, scene, 1);
+  const auto& m11 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s11)).multigrid();
+  const auto& m12 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s12)).multigrid();
+  const auto v11 =
+      ch10::v_cycle_work(ch10::multigrid_levels(m11), ch10::smoother_products(m11), 8, false);
+  const auto v12 =
+      ch10::v_cycle_work(ch10::multigrid_levels(m12), ch10::smoother_products(m12), 4, true);
+  CHECK(v12.bytes() < v11.bytes());
+  // Per iteration of the solve, the V-cycle's bytes are the chapter's own.
+  const double it11 = s11->profile().cg_iterations, it12 = s12->profile().cg_iterations;
+  CHECK(phase(w12, "solve").bytes() / (it12 + 1) < phase(w11, "solve").bytes() / (it11 + 1));
+  CHECK(phase(w12, "solve").flops_float > 0.0);
+  CHECK(phase(w11, "solve").flops_float == 0.0);
 }
 
 TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofline]") {
@@ -70,7 +165,7 @@ TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofl
   ch10::MultigridStepper stepper(scene, {});
   State state = rest_state(scene);
   stepper.step(state);
-  const auto levels = roofline::multigrid_levels(stepper.multigrid());
+  const auto levels = ch10::multigrid_levels(stepper.multigrid());
   REQUIRE(int(levels.size()) == stepper.multigrid().levels());
   CHECK(levels.back().coarsest);
   for (std::size_t l = 0; l < levels.size(); ++l) {
@@ -83,32 +178,32 @@ TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofl
             double(ch10::prolongator(stepper.multigrid(), int(l)).nonZeros()));
   }
   // A float V-cycle streams fewer bytes than a double one over the same levels.
-  const int products = roofline::smoother_products(stepper.multigrid());
+  const int products = ch10::smoother_products(stepper.multigrid());
   CHECK(products >= 2);
-  CHECK(roofline::v_cycle_work(levels, products, 4, true).bytes <
-        roofline::v_cycle_work(levels, products, 8, false).bytes);
+  CHECK(ch10::v_cycle_work(levels, products, 4, true).bytes() <
+        ch10::v_cycle_work(levels, products, 8, false).bytes());
 }
 
-TEST_CASE("roofline: the registry's steppers are counted through their wrapper", "[roofline]") {
+TEST_CASE("roofline: every chapter of the course counts its work through the registry",
+          "[roofline]") {
   const Scene scene = test::test_scene("cantilever");
   for (const ChapterInfo& c : chapters()) {
     if (!c.variant_of.empty()) continue;
+    INFO(c.id);
     const auto stepper = c.make(scene, {});
-    State state = rest_state(scene);
-    stepper->step(state);
-    std::string counted_as;
-    const auto work = roofline::count_work(*stepper, scene, 1, counted_as);
-    CHECK(counted_as == c.id.substr(0, 2));
+    const auto work = stepped_work(c, *stepper, scene, 1);
+    CHECK(work.size() >= 4);
     for (const auto& w : work) {
-      CHECK(w.bytes > 0);
-      CHECK(w.working_set <= w.bytes);
+      CHECK(w.bytes_read > 0);
+      CHECK(w.bytes_allocated <= w.bytes_written);
+      CHECK(w.working_set <= w.bytes());
     }
   }
 }
 
 TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roofline]") {
-  const std::vector<roofline::CacheLevel> caches = {
-      {1, 48 << 10, 1}, {2, 1 << 20, 1}, {3, 32 << 20, 2}};
+  const std::vector<CacheLevel> caches = {
+      {1, "Data", 48 << 10, 1}, {2, "Unified", 1 << 20, 1}, {3, "Unified", 32 << 20, 2}};
   for (const int threads : {1, 2}) {
     const auto levels = roofline::memory_levels(caches, threads);
     REQUIRE(levels.size() == 4);
@@ -118,4 +213,25 @@ TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roo
     CHECK(levels[2].capacity == std::size_t(32 << 20) / threads);
     CHECK(levels.back().working_set * threads >= std::size_t(4) * (32 << 20));
   }
+}
+
+TEST_CASE("roofline: a threaded step counts its team and its synchronizations", "[roofline]") {
+  const Scene scene = test::test_scene("cantilever");
+  const ChapterInfo& chapter = find_chapter("09");
+  const auto stepper = chapter.make(scene, {});
+  auto* threads = dynamic_cast<ch09::ThreadsStepper*>(stepper.get());
+  REQUIRE(threads);
+  threads->adaptive_team().set_enabled(false);  // the given team on every step
+  const ThreadCountScope team(2);
+  State state = rest_state(scene);
+  stepper->step(state);
+  REQUIRE(chapter.work.executed);
+  const ExecutedWork before = chapter.work.executed(*stepper);
+  stepper->step(state);
+  const ExecutedWork e = chapter.work.executed(*stepper).since(before);
+  CHECK(e.team == 2.0);
+  CHECK(e.steps == 1.0);
+  CHECK(e.regions >= 1.0);
+  // Every PCG iteration ends worksharing loops (a barrier each): at least one per iteration.
+  CHECK(e.barriers >= stepper->profile().cg_iterations);
 }

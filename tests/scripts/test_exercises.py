@@ -143,7 +143,7 @@ EXERCISES = [
      "bench": "build/release/fem_bench --chapters 12,12_NAME --threads 1,2 --steps 30 --no-solvers --no-json",
      "expect": "measured"},
     {"id": "12/2", "chapter": "12", "name": "ex_unpadded",
-     "change": [("reduced_v_cycle.cpp",
+     "change": [("reduced_kernels.hpp",
                  "  using Column = Eigen::Matrix<float, Lanes<R>, 1>;\n  for (int j = 0; j < C; ++j)\n"
                  "    sums.of(j) += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];\n",
                  "  for (int j = 0; j < C; ++j)\n"

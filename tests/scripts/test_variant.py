@@ -59,7 +59,7 @@ def main():
               and "diff my_fused_updates" in p.stdout and "edit chapters/" not in p.stdout, p.stdout)
         variant = repo / "chapters" / "06_my_fused_updates"
         check("the copy has the original's files",
-              sorted(f.name for f in (repo / "chapters" / "06_custom_pcg").iterdir()) + ["variant_of"]
+              sorted([f.name for f in (repo / "chapters" / "06_custom_pcg").iterdir()] + ["variant_of"])
               == sorted(f.name for f in variant.iterdir()), list(variant.iterdir()))
         check("variant_of names the original",
               (variant / "variant_of").read_text().strip() == "06_custom_pcg")

@@ -35,7 +35,7 @@ def copy_repo(tmp, venv):
         return {n for n in names if n in ("__pycache__", "build", ".venv")
                 or (pathlib.Path(directory) / n / "variant_of").exists()}
     repo = tmp / "repo"
-    for part in ("chapters", "common", "apps", "tests", "tools"):
+    for part in ("chapters", "common", "femcourse", "cmake", "apps", "tests", "tools"):
         shutil.copytree(ROOT / part, repo / part, ignore=ignore)
     (repo / "meshes").mkdir()
     for mesh in ("test_beam.msh", "plate_poster.msh"):

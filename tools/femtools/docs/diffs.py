@@ -45,7 +45,8 @@ def names(chapter):
 
 def renamed(text, old, new):
     """text of chapter `old` with the names of chapter `new`."""
-    text = text.replace(f"chapters/{old['id']}/stepper.hpp", f"chapters/{new['id']}/stepper.hpp")
+    # Its own stepper.hpp and work.hpp (the registry's files) under its own name.
+    text = re.sub(rf"chapters/{old['id']}/(stepper|work)\.hpp", rf"chapters/{new['id']}/\1.hpp", text)
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
     if old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)

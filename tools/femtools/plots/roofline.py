@@ -1,11 +1,18 @@
 """The roofline plot of `fem_lessons roofline --json FILE` (its "data"): the machine's roofs
 (read bandwidth of each level of the memory hierarchy and the peak multiply-add rate, as
 measured) and one point per chapter and phase, at the phase's arithmetic intensity (flops per
-byte counted from the chapter's data) and the rate it achieved (those flops over its measured
-median time). A panel per thread count; a point's distance below the roof of its level is its
-distance from the bound (Williams, Waterman & Patterson, CACM 52(4), 2009).
+byte of traffic counted from the chapter's data: reads, writes and the line reads of
+allocating writes) and the rate it achieved (those flops over its measured median time). A
+panel per thread count: the cache-aware roofline (Ilic, Pratas & Sousa, IEEE CAL 2014), one
+roof per level, after the DRAM roofline of Williams, Waterman & Patterson (CACM 52(4), 2009).
 
     fem-tools plots roofline results/roofline.json --out results/roofline.png
+    fem-tools plots roofline docs/data/lessons/roofline.json --check
+
+--check draws nothing: it exits 1 if a phase ran faster than its bound allows (measured time
+below the bound: the model is broken there, and committed data must not hold one), or if the
+data lack a field the plot and the page read; data recorded with `fem_lessons roofline
+--provisional REASON` (a placeholder, the page says so in bold) get warnings instead.
 """
 import json
 import pathlib
@@ -19,6 +26,35 @@ from femtools.args import command_parser
 from femtools.files import replacing
 from femtools.results.phases import marker, parts
 
+PHASE_FIELDS = ("phase", "bytes_read", "bytes_written", "bytes_allocated", "flops_double", "flops_float",
+                "working_set", "level", "bound_s", "memory_s", "arithmetic_s", "measured_s")
+
+
+def traffic(p):
+    """A phase's bytes: reads, writes and the line reads its allocating writes cost."""
+    return p["bytes_read"] + p["bytes_written"] + p["bytes_allocated"]
+
+
+def problems(data):
+    """What --check refuses: missing fields, and phases measured faster than their bound."""
+    found = []
+    for roof in data.get("roofs", []):
+        for level in roof["levels"]:
+            if "write" not in level:
+                found.append(f"roofs at {roof['threads']} thread(s): level {level['name']} has no write roof")
+    for r in data.get("runs", []):
+        name = f"{r['chapter']}@{r['threads']} on {r['mesh']}"
+        for p in r["phases"]:
+            missing = [f for f in PHASE_FIELDS if f not in p]
+            if missing:
+                found.append(f"{name} {p.get('phase', '?')}: no {', '.join(missing)}")
+            elif p["measured_s"] < p["bound_s"]:
+                found.append(f"{name} {p['phase']}: measured {p['measured_s'] * 1e3:.3g} ms, below its bound "
+                             f"{p['bound_s'] * 1e3:.3g} ms ({100 * p['bound_s'] / p['measured_s']:.0f}% of the "
+                             "bound): a broken model")
+    return found
+
+
 # One marker per phase of the step (results/phases.py).
 MARKERS = {p: marker(p) for p in parts()}
 
@@ -30,6 +66,8 @@ def roofs(ax, roof, x):
         ax.plot(x, np.minimum(peak, x * bw), lw=1, color="0.35")
         ax.text(x[0] * 1.3, x[0] * 1.3 * bw * 1.15, f"{level['name']} {bw:.0f} GB/s", fontsize=7,
                 color="0.25")
+        # The write roof of the level, dotted: a phase that mostly writes sits under it.
+        ax.plot(x, np.minimum(peak, x * level["write"] / 1e9), lw=0.8, color="0.55", ls=":")
     ax.axhline(peak, lw=1, color="0.35", ls="-")
     ax.axhline(roof["peak_float"] / 1e9, lw=1, color="0.6", ls="--")
     ax.text(x[-1], peak * 1.08, f"double peak {peak:.0f} Gflop/s", fontsize=7, ha="right")
@@ -49,7 +87,7 @@ def points(ax, runs, threads):
                 continue
             hollow = meshes.index(r["mesh"]) > 0  # a further mesh: hollow markers
             c = colours[r["chapter"]]
-            ax.scatter(flops / p["bytes"], flops / p["measured_s"] / 1e9, marker=MARKERS.get(p["phase"], "x"),
+            ax.scatter(flops / traffic(p), flops / p["measured_s"] / 1e9, marker=MARKERS.get(p["phase"], "x"),
                        s=28, facecolors="none" if hollow else c, edgecolors=c, linewidths=1)
     return chapters, colours, meshes
 
@@ -62,16 +100,22 @@ def legend(fig, chapters, colours, meshes):
     fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
 
 
-def main(argv=None, prog=None):
-    parser = command_parser(prog, __doc__)
-    parser.add_argument("json", type=pathlib.Path)
-    parser.add_argument("--out", type=pathlib.Path, required=True, help="the PNG to write")
-    args = parser.parse_args(argv)
-    record = json.loads(args.json.read_text())
-    data = record.get("data")
-    if not data or not data.get("roofs"):
-        print(f"fem-tools plots roofline: {args.json} has no roofline data (fem_lessons roofline --json)", file=sys.stderr)
-        return 1
+def check(path, data):
+    """--check: the data's problems on stderr; exit status 1 if any (warnings only for data
+    recorded as provisional)."""
+    found = problems(data)
+    provisional = data.get("provisional")
+    for line in found:
+        print(f"fem-tools plots roofline: {path}: {'warning: ' if provisional else ''}{line}", file=sys.stderr)
+    if provisional:
+        print(f"{path}: provisional data ({provisional}): re-record it before it is read")
+        return 0
+    if not found:
+        print(f"{path}: every phase at or under its bound")
+    return 1 if found else 0
+
+
+def draw(data, out):
     panels = data["roofs"]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels) + 2.2, 4.6), squeeze=False)
     x = np.logspace(-3, 2, 200)
@@ -85,9 +129,30 @@ def main(argv=None, prog=None):
         ax.set_title(f"{roof['threads']} thread(s)", fontsize=10)
         ax.set_ylim(1e-3, roof["peak_float"] / 1e9 * 3)
     legend(fig, chapters, colours, meshes)
+    if data.get("provisional"):
+        fig.suptitle(f"PROVISIONAL, not to be read: {data['provisional']}", fontsize=9, color="C3")
     fig.tight_layout(rect=(0, 0, 1 - 2.0 / fig.get_figwidth(), 1))
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with replacing(args.out) as tmp:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with replacing(out) as tmp:
         fig.savefig(tmp, dpi=130)
-    print(f"wrote {args.out}")
+    print(f"wrote {out}")
+
+
+def main(argv=None, prog=None):
+    parser = command_parser(prog, __doc__)
+    parser.add_argument("json", type=pathlib.Path)
+    parser.add_argument("--out", type=pathlib.Path, help="the PNG to write")
+    parser.add_argument("--check", action="store_true", help="check the data, draw nothing")
+    args = parser.parse_args(argv)
+    if not args.check and args.out is None:
+        parser.error("give --out PNG, or --check")
+    record = json.loads(args.json.read_text())
+    data = record.get("data")
+    if not data or not data.get("roofs"):
+        print(f"fem-tools plots roofline: {args.json} has no roofline data (fem_lessons roofline --json)",
+              file=sys.stderr)
+        return 1
+    if args.check:
+        return check(args.json, data)
+    draw(data, args.out)
     return 0

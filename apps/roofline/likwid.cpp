@@ -1,0 +1,98 @@
+#include "apps/roofline/likwid.hpp"
+
+#include <Eigen/Core>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+namespace fem::roofline {
+
+namespace {
+
+// The kernel's name for the build's vector width: AVX-512 where Eigen's packets hold 8
+// doubles, AVX (with FMA for the peak) where they hold 4.
+std::string kernel_name(LikwidKernel kernel) {
+  const bool wide = Eigen::internal::packet_traits<double>::size >= 8;
+  const std::string isa = wide ? "avx512" : "avx";
+  switch (kernel) {
+    case LikwidKernel::load:
+      return "load_" + isa;
+    case LikwidKernel::store:
+      return "store_" + isa;
+    case LikwidKernel::peak:
+      return "peakflops_" + isa + "_fma";
+  }
+  return "";
+}
+
+// The command's standard output and error, and its exit status.
+std::string run(const std::string& command, int& status) {
+  std::string out;
+  const std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  if (!pipe) {
+    status = -1;
+    return out;
+  }
+  std::array<char, 4096> buffer{};
+  for (std::size_t n; (n = fread(buffer.data(), 1, buffer.size(), pipe.get())) > 0;)
+    out.append(buffer.data(), n);
+  status = 0;
+  return out;
+}
+
+// The number after "<label>:" in likwid-bench's report, or 0.
+double field(const std::string& report, const std::string& label) {
+  const std::size_t at = report.find("\n" + label + ":");
+  if (at == std::string::npos) return 0.0;
+  std::istringstream in(report.substr(at + label.size() + 2));
+  double value = 0.0;
+  in >> value;
+  return value;
+}
+
+}  // namespace
+
+LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
+                        double seconds) {
+  LikwidRate r;
+  r.kernel = kernel_name(kernel);
+  int status = 0;
+  if (run("command -v likwid-bench >/dev/null 2>&1 && echo yes", status).find("yes") ==
+      std::string::npos) {
+    r.note = "likwid-bench not installed (Debian: likwid)";
+    return r;
+  }
+  const std::size_t kb = std::max<std::size_t>(1, bytes_per_thread * threads / 1024);
+  std::ostringstream command;
+  command << "likwid-bench -t " << r.kernel << " -W S0:" << kb << "kB:" << threads << " -s "
+          << std::max(seconds, 0.1) << " 2>&1";
+  const std::string report = run(command.str(), status);
+  const bool flops = kernel == LikwidKernel::peak;
+  r.rate = field(report, flops ? "MFlops/s" : "MByte/s") * 1e6;
+  if (r.rate <= 0.0) {
+    const std::size_t line = report.find('\n');
+    r.note = "likwid-bench did not report: " + report.substr(0, std::min<std::size_t>(line, 120));
+  }
+  return r;
+}
+
+double measured_clock() {
+  using Clock = std::chrono::steady_clock;
+  constexpr long long kAdds = 200'000'000;
+  double best = 0.0;
+  for (int repeat = 0; repeat < 5; ++repeat) {
+    long long x = repeat;
+    const Clock::time_point start = Clock::now();
+    for (long long i = 0; i < kAdds; ++i) {
+      x += 1;  // each add waits for the last: one per cycle, whatever the core's width
+      asm volatile("" : "+r"(x));  // kept in a register, never folded
+    }
+    const double t = std::chrono::duration<double>(Clock::now() - start).count();
+    best = std::max(best, double(kAdds + x - x) / t);
+  }
+  return best;
+}
+
+}  // namespace fem::roofline

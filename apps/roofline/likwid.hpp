@@ -1,0 +1,34 @@
+// The roofs' independent check: the same working sets and thread counts measured by
+// likwid-bench (Treibig, Hager & Wellein, "LIKWID: a lightweight performance-oriented tool
+// suite for x86 multicore environments", ICPPW 2010; Debian's `likwid`), whose kernels are
+// hand-written assembly: a roof of ours far below its number is a kernel of ours that does not
+// reach the hardware; far above it, a timing that credits more than the machine sustains.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace fem::roofline {
+
+// What likwid-bench measured, or why it did not.
+struct LikwidRate {
+  double rate = 0.0;  // bytes/s (load, store kernels) or flops/s (peakflops); 0 if not run
+  std::string kernel;
+  std::string note;  // empty if it ran; else why not ("not installed", its error)
+};
+
+enum class LikwidKernel { load, store, peak };
+
+// likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
+// `threads` threads of its domain S0, each allocating and touching its own chunk of
+// `bytes_per_thread` (-W), running at least `seconds`.
+LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
+                        double seconds);
+
+// The core's own limit at the clock measured on the spot: `per_cycle` loads (or multiply-
+// adds) of one packet each per cycle, times the packet's bytes (or its 2 flops per lane),
+// times the clock, times the threads. measured_clock() times a chain of dependent integer
+// additions, one per cycle on every x86 and ARM core of the last decade.
+double measured_clock();
+
+}  // namespace fem::roofline

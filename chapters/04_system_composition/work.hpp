@@ -1,0 +1,16 @@
+// This chapter's work per phase (chapters/work.hpp: the model): its compressed matrices
+// counted as the first chapter's data model counts them, the constraints as the sparse products S A
+// S^T into a second matrix.
+#pragma once
+
+#include <vector>
+
+#include "chapters/04_system_composition/stepper.hpp"
+#include "chapters/work.hpp"
+
+namespace fem::ch04 {
+
+std::vector<PhaseWork> count_work(const SystemCompositionStepper& stepper, const Scene& scene,
+                                  const WorkCounts& counts);
+
+}  // namespace fem::ch04

@@ -1,0 +1,107 @@
+// The work of one step, phase by phase, as each chapter counts it from its own data: the
+// registry's `work` hook (registry.hpp), which the roofline lesson (apps/roofline) sets under
+// the machine's roofs. A chapter counts its work in its own folder (chapters/NN_name/work.hpp
+// declares `count_work(const <its stepper>&, const Scene&, const WorkCounts&)` in its
+// namespace); a chapter that adds no data of its own is counted by the chapter it extends, and
+// a student's variant, a copy of the folder, by its own copy.
+//
+// The model, kept simple so that a student can check it by hand (docs/roofline.md):
+//  - bytes read and bytes written: every array a phase reads or writes, once per pass over it
+//    (the compulsory traffic of the chapter's algorithm on its data structures). A write to a
+//    line the pass did not read first costs that line's read too (write-allocate): the count
+//    says so where it adds it.
+//  - flops: the arithmetic the phase executes, a multiply or an add each (a multiply-add is
+//    2), with the iterations it ran (CG, the rotations' Newton) as counted during the steps.
+//  - working set: the distinct bytes one pass touches; the level of the cache hierarchy that
+//    holds it gives the bandwidth.
+#pragma once
+
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "common/stepper.hpp"
+
+namespace fem {
+
+struct PhaseWork {
+  std::string phase;  // a StepProfile phase: "forces", "dfdx", "compose", "constraints", "solve"
+  double bytes_read = 0.0;       // arrays read (an array read and written back counts in both)
+  double bytes_written = 0.0;    // arrays written
+  double bytes_allocated = 0.0;  // of those, written to lines the pass did not read first:
+                                 // the store reads each such line before it writes it
+  double flops_double = 0.0;
+  double flops_float = 0.0;  // float arithmetic, priced at the float peak
+  double working_set = 0.0;  // bytes one pass over the phase's data touches
+
+  // The traffic: reads, writes and the line reads the allocating writes cost.
+  double bytes() const { return bytes_read + bytes_written + bytes_allocated; }
+};
+
+// What a stepper ran, summed since it was made (its counters; zero where it has none): the
+// roofline takes the difference over its measured steps.
+struct ExecutedWork {
+  double steps = 0.0;
+  double rotations = 0.0;            // element rotations computed
+  double rotation_iterations = 0.0;  // Newton iterations they took (fallbacks excluded)
+  double rotation_fallbacks = 0.0;   // rotations Newton left to the SVD
+  double team = 0.0;  // threads the last step ran on (an adaptive team may take one); 0: not said
+  double regions = 0.0;   // parallel regions opened (with more than one thread)
+  double barriers = 0.0;  // barriers met (a team's counted once)
+
+  ExecutedWork since(const ExecutedWork& before) const {
+    return {steps - before.steps,
+            rotations - before.rotations,
+            rotation_iterations - before.rotation_iterations,
+            rotation_fallbacks - before.rotation_fallbacks,
+            team,
+            regions - before.regions,
+            barriers - before.barriers};
+  }
+};
+
+// The counts a chapter's work depends on, per step: the solve's iterations and what the
+// stepper's counters say it ran (ExecutedWork over the measured steps, divided by them).
+struct WorkCounts {
+  double cg_iterations = 0.0;
+  ExecutedWork per_step;
+};
+
+// The hook of ChapterInfo: both null for a chapter that counts nothing.
+struct ChapterWork {
+  std::vector<PhaseWork> (*count)(const Stepper&, const Scene&, const WorkCounts&) = nullptr;
+  ExecutedWork (*executed)(const Stepper&) = nullptr;
+};
+
+// The hook of a chapter whose stepper is S: count_work (and executed_work, if any) for S's
+// class or the class it derives from nearest, found by argument-dependent lookup in those
+// classes' namespaces. The registry fills ChapterInfo::work with it.
+template <class S, class = void>
+struct CountsWork : std::false_type {};
+template <class S>
+struct CountsWork<
+    S, std::void_t<decltype(count_work(std::declval<const S&>(), std::declval<const Scene&>(),
+                                       std::declval<const WorkCounts&>()))>> : std::true_type {};
+template <class S, class = void>
+struct CountsExecuted : std::false_type {};
+template <class S>
+struct CountsExecuted<S, std::void_t<decltype(executed_work(std::declval<const S&>()))>>
+    : std::true_type {};
+
+template <class S>
+ChapterWork work_of() {
+  ChapterWork work;
+  if constexpr (CountsWork<S>::value)
+    work.count = [](const Stepper& s, const Scene& scene, const WorkCounts& counts) {
+      return count_work(dynamic_cast<const S&>(unwrapped(s)), scene, counts);
+    };
+  if constexpr (CountsExecuted<S>::value)
+    work.executed = [](const Stepper& s) {
+      return executed_work(dynamic_cast<const S&>(unwrapped(s)));
+    };
+  return work;
+}
+
+}  // namespace fem
