@@ -22,6 +22,7 @@ class HalfBytesStepper : public ch11::NodeOrderStepper {
                    const ch10::MultigridStepperSettings& multigrid = {});
 
   Arithmetic arithmetic() const { return arithmetic_; }
+  const BatchedElements& batched_elements() const { return batched_; }
   // The preconditioner (the lesson times it alone; outside a team it runs on one thread).
   ch09::Preconditioner& v_cycle() { return *v_cycle_; }
 
