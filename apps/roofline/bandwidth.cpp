@@ -64,13 +64,19 @@ std::vector<CacheLevel> fallback_levels() {
 
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads) {
   std::vector<MemoryLevel> levels;
-  std::size_t largest = 0;
+  std::size_t largest = 0, inner = 0;
   for (const CacheLevel& c : caches) {
     // A shared cache holds every thread's data: each thread gets its share.
     const int sharing = std::min(std::max(threads, 1), c.shared_by);
     const std::size_t per_thread = std::size_t(c.bytes) / static_cast<std::size_t>(sharing);
-    levels.push_back({"L" + std::to_string(c.level), per_thread, per_thread / 2});
+    // Half the level, but no more than four times the level inside it: the array is then out
+    // of the inner level and well inside this one, also where a virtual machine reports a
+    // last-level cache far larger than the share its host gives it.
+    const std::size_t working_set =
+        inner > 0 ? std::min(per_thread / 2, 4 * inner) : per_thread / 2;
+    levels.push_back({"L" + std::to_string(c.level), per_thread, working_set});
     largest = std::max(largest, std::size_t(c.bytes));
+    inner = per_thread;
   }
   const std::size_t memory = std::max<std::size_t>(largest, std::size_t(8) << 20) * 4;
   levels.push_back({"memory", 0, memory / static_cast<std::size_t>(std::max(threads, 1))});

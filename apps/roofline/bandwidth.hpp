@@ -29,7 +29,8 @@ struct MemoryLevel {
 
 // The levels with the working set each measurement uses: half of a private cache (so that
 // the code and the stack do not push the array out), half of a shared cache split between
-// `threads`, and memory at four times the largest cache.
+// `threads`, each at most four times the share of the level inside it, and memory at four
+// times the largest cache.
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads);
 
 // The best read bandwidth (bytes/s) of `threads` threads, each summing its own array of
