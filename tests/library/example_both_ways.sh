@@ -28,11 +28,15 @@ if grep -rqiE "gmsh|catch2|python|$repo" "$work/prefix/lib/cmake/femcourse/femco
   exit 1
 fi
 
+# The consumer compiles with the build's own compiler: a library built by Clang calls Clang's
+# OpenMP runtime (libomp), which GCC's OpenMP::OpenMP_CXX (libgomp) does not provide.
+compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+
 build_example() {  # NAME CMAKE_ARGS...
   local name=$1
   shift
   cmake -S "$repo/examples/beam" -B "$work/$name" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-    "${launcher[@]}" "$@" >"$work/$name.configure.log"
+    ${compiler:+"-DCMAKE_CXX_COMPILER=$compiler"} "${launcher[@]}" "$@" >"$work/$name.configure.log"
   cmake --build "$work/$name" 2>&1 | tee "$work/$name.build.log" | tail -n 1
   if grep -q "warning:" "$work/$name.build.log"; then
     grep -B2 -A6 "warning:" "$work/$name.build.log" | head -n 40 >&2
