@@ -13,7 +13,10 @@
 //  - flops: the arithmetic the phase executes, a multiply or an add each (a multiply-add is
 //    2), with the iterations it ran (CG, the rotations' Newton) as counted during the steps.
 //  - working set: the distinct bytes one pass touches; the level of the cache hierarchy that
-//    holds it gives the bandwidth.
+//    holds it gives the bandwidth. A phase made of kernels that run one after another on data
+//    of different sizes (a solve: the PCG's passes, a V-cycle's levels) lists them as parts,
+//    each with its own working set and so its own level: its whole working set in one level
+//    would price the fine level's kernels, whose data fit an inner cache, at an outer one.
 #pragma once
 
 #include <string>
@@ -35,9 +38,33 @@ struct PhaseWork {
   double flops_double = 0.0;
   double flops_float = 0.0;  // float arithmetic, priced at the float peak
   double working_set = 0.0;  // bytes one pass over the phase's data touches
+  // The kernels the phase is made of, each run as often as the phase runs it (the totals
+  // above are their sums); empty: the phase is one kernel on its working set.
+  std::vector<PhaseWork> parts;
 
   // The traffic: reads, writes and the line reads the allocating writes cost.
   double bytes() const { return bytes_read + bytes_written + bytes_allocated; }
+
+  // `part` run `times` added to the totals and to the parts (a part's own parts in its place,
+  // so that every part is one kernel); the working set is the caller's to say.
+  void add_part(const PhaseWork& part, double times) {
+    if (!part.parts.empty()) {
+      for (const PhaseWork& p : part.parts) add_part(p, times);
+      return;
+    }
+    PhaseWork run = part;
+    run.bytes_read *= times;
+    run.bytes_written *= times;
+    run.bytes_allocated *= times;
+    run.flops_double *= times;
+    run.flops_float *= times;
+    bytes_read += run.bytes_read;
+    bytes_written += run.bytes_written;
+    bytes_allocated += run.bytes_allocated;
+    flops_double += run.flops_double;
+    flops_float += run.flops_float;
+    parts.push_back(std::move(run));
+  }
 };
 
 // What a stepper ran, summed since it was made (its counters; zero where it has none): the

@@ -73,7 +73,7 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
     std::vector<double> seconds;
     for (const StepProfile& p : profiles) seconds.push_back(phase_seconds(p, w.phase));
     const PhasePoint point{w,
-                           fitting_level(roofs, w.working_set).level.name,
+                           fitting_levels(roofs, w),
                            bound_seconds(roofs, w),
                            memory_seconds(roofs, w),
                            arithmetic_seconds(roofs, w),

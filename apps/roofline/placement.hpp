@@ -13,9 +13,9 @@ namespace fem::roofline {
 
 struct PhasePoint {
   PhaseWork work;
-  std::string level;          // where its working set fits: "L1", ..., "memory"
+  std::string level;          // where its working set fits: "L1", ..., "memory", or "L2+L3"
   double bound_s = 0.0;       // bound_seconds: the longer of the two below
-  double memory_s = 0.0;      // its bytes at the roofs of its level
+  double memory_s = 0.0;      // its bytes (or its parts') at the roofs of their levels
   double arithmetic_s = 0.0;  // its flops at the peaks
   double measured_s = 0.0;    // the median of the measured steps
 };

@@ -45,8 +45,25 @@ const LevelRoof& fitting_level(const Roofs& roofs, double working_set) {
 }
 
 double memory_seconds(const Roofs& roofs, const PhaseWork& work) {
+  if (!work.parts.empty()) {
+    double seconds = 0.0;
+    for (const PhaseWork& part : work.parts) seconds += memory_seconds(roofs, part);
+    return seconds;
+  }
   const LevelRoof& level = fitting_level(roofs, work.working_set);
   return work.bytes_read / level.read + work.bytes_written / level.write;
+}
+
+std::string fitting_levels(const Roofs& roofs, const PhaseWork& work) {
+  if (work.parts.empty()) return fitting_level(roofs, work.working_set).level.name;
+  std::string names;
+  for (const LevelRoof& level : roofs.levels)
+    for (const PhaseWork& part : work.parts)
+      if (&fitting_level(roofs, part.working_set) == &level) {
+        names += (names.empty() ? "" : "+") + level.level.name;
+        break;
+      }
+  return names;
 }
 
 double arithmetic_seconds(const Roofs& roofs, const PhaseWork& work) {

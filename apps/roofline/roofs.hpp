@@ -44,10 +44,14 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
 // The innermost level whose share per thread holds the working set (memory if none).
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
+// The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.
+std::string fitting_levels(const Roofs& roofs, const PhaseWork& work);
+
 // The time the roofs allow a phase: its bytes read at the read roof and its bytes written at
 // the write roof of the level its working set fits (the write roof's stores allocate their
 // lines as the phase's do), or its flops at the peak (double and float flops each at their
-// own), the longer.
+// own), the longer. A phase made of parts: the sum of each part's bytes at the roofs of the
+// level its own working set fits (they run one after another), or all its flops at the peak.
 double bound_seconds(const Roofs& roofs, const PhaseWork& work);
 // Its two parts: the bytes' time and the flops' time.
 double memory_seconds(const Roofs& roofs, const PhaseWork& work);

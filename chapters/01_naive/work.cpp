@@ -62,15 +62,26 @@ PhaseWork pcg_work(const MeshSizes& m, double iterations, double matrix, double 
                    const PhaseWork& preconditioner) {
   const double passes = iterations + 1.0;
   const double v = m.vector_bytes;
-  // Read: the matrix with p, the preconditioner's data with r, and two vectors per update.
-  const double read = matrix + v + preconditioner.bytes_read + v + 3 * 2 * v;
-  // Written: q and z, fresh lines; x, r and p, lines their update read.
-  const double written = preconditioner.bytes_written + 2 * v + 3 * v;
-  PhaseWork w = phase_work("solve", passes * read, passes * written,
-                           passes * (preconditioner.bytes_allocated + 2 * v),
-                           passes * (matrix_flops + preconditioner.flops_double + 10 * m.dofs),
-                           matrix + preconditioner.working_set + 5 * v);
-  w.flops_float = passes * preconditioner.flops_float;
+  // The PCG's own kernels: the product (the matrix and p read, q written fresh) and the
+  // updates (two vectors read each, x, r and p written back).
+  PhaseWork own = phase_work("pcg", matrix + v + 3 * 2 * v, v + 3 * v, v,
+                             matrix_flops + 10 * m.dofs, matrix + 5 * v);
+  // The preconditioner reads r and writes z (fresh lines) besides its own data; a
+  // preconditioner made of kernels (a V-cycle) keeps them, each at its own level.
+  PhaseWork apply = phase_work("preconditioner", v, v, v, 0.0, 2 * v);
+  if (preconditioner.parts.empty()) {
+    apply.bytes_read += preconditioner.bytes_read;
+    apply.bytes_written += preconditioner.bytes_written;
+    apply.bytes_allocated += preconditioner.bytes_allocated;
+    apply.flops_double = preconditioner.flops_double;
+    apply.flops_float = preconditioner.flops_float;
+    apply.working_set += preconditioner.working_set;
+  }
+  PhaseWork w =
+      phase_work("solve", 0.0, 0.0, 0.0, 0.0, matrix + preconditioner.working_set + 5 * v);
+  w.add_part(own, passes);
+  w.add_part(apply, passes);
+  if (!preconditioner.parts.empty()) w.add_part(preconditioner, passes);
   return w;
 }
 

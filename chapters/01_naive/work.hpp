@@ -32,8 +32,9 @@ double matrix_bytes(const Eigen::SparseMatrix<double>& m);
 // A PCG solve: the initial residual's product and `iterations` iterations, each a product
 // (the matrix and p read, q written), the preconditioner (r read, z written) and the vector
 // updates x += a p, r -= a q, p = z + b p (each reads two vectors and writes one it read);
-// the dot products ride on those passes. Working set: the matrix, the preconditioner, the
-// five vectors x, r, p, q, z.
+// the dot products ride on those passes. Its parts: the product and updates on the matrix
+// and the five vectors x, r, p, q, z; the preconditioner on its data, r and z (or, if it is
+// made of parts, each of them).
 PhaseWork pcg_work(const MeshSizes& m, double iterations, double matrix, double matrix_flops,
                    const PhaseWork& preconditioner);
 

@@ -35,9 +35,9 @@ std::vector<PhaseWork> fused_work(const ElementKernelsStepper& stepper, const Sc
                        0.0, m.elements * fused_element_flops() + rotation_flops(counts, m.elements),
                        m.elements * per_element + blocks + 3 * v);
   PhaseWork solve = ch01::pcg_work(m, counts.cg_iterations, matrix, 2 * entries, preconditioner);
-  solve.bytes_read += prepare_read;
-  solve.bytes_written += prepare_written;
-  solve.bytes_allocated += prepare_written;
+  solve.add_part(ch01::phase_work("prepare", prepare_read, prepare_written, prepare_written, 0.0,
+                                  prepare_read + prepare_written),
+                 1.0);
   return {forces, compose, ch07::block_constraints(m, A, scene), solve};
 }
 

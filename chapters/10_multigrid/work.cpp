@@ -1,5 +1,8 @@
 #include "chapters/10_multigrid/work.hpp"
 
+#include <string>
+#include <utility>
+
 #include "chapters/08_element_kernels/work.hpp"
 #include "chapters/10_multigrid/report.hpp"
 
@@ -25,26 +28,26 @@ PhaseWork level_product(const LevelSize& l, int scalar) {
   return w;
 }
 
-// Restriction by R = P^T (stored apart) and prolongation by P, each read once, with the
-// residual read and x read and written back (the coarse vectors are a level's smaller ones).
-PhaseWork level_transfer(const LevelSize& l, int scalar) {
+// Restriction by R = P^T (stored apart) with the residual read, or prolongation by P with x
+// read and written back: the operator and one of the level's vectors each (the coarse
+// vectors are the next level's, smaller ones).
+PhaseWork level_transfer(const LevelSize& l, int scalar, bool prolongation) {
   const double operator_bytes =
       double(l.transfer) * l.block * kModes * scalar + double(l.transfer + l.nodes + 1) * 4;
   const double vector = double(l.nodes) * l.block * scalar;
   PhaseWork w;
-  w.bytes_read = 2 * operator_bytes + 2 * vector;
-  w.bytes_written = vector;
-  w.flops_double = 2 * 2 * double(l.transfer) * l.block * kModes;
-  w.working_set = 2 * operator_bytes;
+  w.bytes_read = operator_bytes + vector;
+  w.bytes_written = prolongation ? vector : 0.0;
+  w.flops_double = 2 * double(l.transfer) * l.block * kModes;
+  w.working_set = operator_bytes + vector;
   return w;
 }
 
-void add(PhaseWork& to, const PhaseWork& w, double times) {
-  to.bytes_read += times * w.bytes_read;
-  to.bytes_written += times * w.bytes_written;
-  to.bytes_allocated += times * w.bytes_allocated;
-  to.flops_double += times * w.flops_double;
-  to.working_set += w.working_set;
+// The part named for its level, its arithmetic in float where the levels' is.
+PhaseWork level_part(PhaseWork w, const std::string& name, bool float_arithmetic) {
+  w.phase = name;
+  if (float_arithmetic) std::swap(w.flops_float, w.flops_double);
+  return w;
 }
 
 }  // namespace
@@ -78,24 +81,29 @@ PhaseWork v_cycle_work(const std::vector<LevelSize>& levels, int products, int s
                        bool float_arithmetic) {
   PhaseWork w;
   w.phase = "v-cycle";
-  for (const LevelSize& l : levels) {
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    const LevelSize& l = levels[k];
+    const std::string level = "level " + std::to_string(k) + " ";
     if (l.coarsest) {
-      // The dense Cholesky factor (double), read by two triangular solves.
+      // The dense Cholesky factor (double, also in a float V-cycle), read by two triangular
+      // solves.
       const double n = double(l.nodes) * l.block;
-      w.bytes_read += n * n * sizeof(double);
-      w.working_set += n * n * sizeof(double);
-      w.flops_double += 2 * n * n;
+      PhaseWork coarsest;
+      coarsest.phase = level + "coarsest solve";
+      coarsest.bytes_read = n * n * sizeof(double);
+      coarsest.flops_double = 2 * n * n;
+      coarsest.working_set = n * n * sizeof(double);
+      w.add_part(coarsest, 1.0);
+      w.working_set += coarsest.working_set;
       continue;
     }
-    add(w, level_product(l, scalar), products);
-    add(w, level_transfer(l, scalar), 1.0);
-  }
-  if (float_arithmetic) {
-    // The levels' arithmetic is in float; the coarsest factor's stays double.
-    const LevelSize& last = levels.back();
-    const double n = last.coarsest ? double(last.nodes) * last.block : 0.0;
-    w.flops_float = w.flops_double - 2 * n * n;
-    w.flops_double = 2 * n * n;
+    const PhaseWork product = level_product(l, scalar);
+    w.add_part(level_part(product, level + "smoothing and residual", float_arithmetic), products);
+    w.add_part(
+        level_part(level_transfer(l, scalar, false), level + "restriction", float_arithmetic), 1.0);
+    w.add_part(
+        level_part(level_transfer(l, scalar, true), level + "prolongation", float_arithmetic), 1.0);
+    w.working_set += product.working_set + level_transfer(l, scalar, true).working_set;
   }
   return w;
 }

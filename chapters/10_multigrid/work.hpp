@@ -1,6 +1,7 @@
 // This chapter's work per phase (chapters/work.hpp: the model): the fused pass's phases as
 // before, and a solve whose preconditioner is one V-cycle per iteration over every level of
-// the hierarchy; the counts of one V-cycle for the chapters that keep it.
+// the hierarchy, each level's kernels a part of the solve at their own working set; the counts of
+// one V-cycle for the chapters that keep it.
 #pragma once
 
 #include <vector>
@@ -31,7 +32,9 @@ std::vector<LevelSize> multigrid_levels(const Multigrid& multigrid);
 // Matrix products per level per V-cycle: pre- and post-smoothing and the residual.
 int smoother_products(const Multigrid& multigrid);
 
-// One V-cycle's bytes and flops over `levels`.
+// One V-cycle's bytes and flops over `levels`, as parts per level: the smoothing steps and
+// the residual (`products` products), the restriction, the prolongation, the coarsest solve;
+// each part's working set that level's data alone.
 PhaseWork v_cycle_work(const std::vector<LevelSize>& levels, int products, int scalar,
                        bool float_arithmetic);
 

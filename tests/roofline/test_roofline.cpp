@@ -184,6 +184,95 @@ TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofl
         ch10::v_cycle_work(levels, products, 8, false).bytes());
 }
 
+namespace {
+
+// The bytes of one level's matrix (its blocks in `scalar` bytes each, its indices), its
+// inverse diagonal and one vector, and of its prolongator P, from the level's own objects.
+template <int B>
+struct LevelBytes {
+  double matrix, inverse, vector, transfer;
+  LevelBytes(const ch10::Level<B>& l, int scalar) {
+    const double b2 = double(B) * B;
+    matrix = double(l.A.column.size()) * b2 * scalar +
+             double(l.A.column.size() + l.A.row_start.size()) * sizeof(int);
+    inverse = double(l.smoother.inverse_diagonal.size()) * b2 * scalar;
+    vector = double(l.vectors.x.size()) * scalar;
+    const auto& P = l.transfer.P;
+    transfer = l.coarsest ? 0.0
+                          : double(P.column.size()) * B * ch10::kModes * scalar +
+                                double(P.column.size() + P.row_start.size()) * sizeof(int);
+  }
+};
+
+// The V-cycle's parts of level `k`, checked against its objects: the smoothing and residual
+// products each read the matrix, the inverse diagonal and three vectors, restriction and
+// prolongation each the operator and one vector; each part's working set its level's data.
+template <int B>
+void check_level(const PhaseWork& v, const ch10::Level<B>& l, int k, int products, int scalar) {
+  INFO("level " << k);
+  const LevelBytes<B> b(l, scalar);
+  const std::string name = "level " + std::to_string(k) + " ";
+  const PhaseWork& smoothing = phase(v.parts, name + "smoothing and residual");
+  CHECK(smoothing.bytes_read == Approx(products * (b.matrix + b.inverse + 3 * b.vector)));
+  CHECK(smoothing.bytes_written == Approx(products * 2 * b.vector));
+  CHECK(smoothing.working_set == Approx(b.matrix + b.inverse + 4 * b.vector));
+  const PhaseWork& restriction = phase(v.parts, name + "restriction");
+  const PhaseWork& prolongation = phase(v.parts, name + "prolongation");
+  CHECK(restriction.bytes_read == Approx(b.transfer + b.vector));
+  CHECK(prolongation.bytes_read == Approx(b.transfer + b.vector));
+  CHECK(prolongation.bytes_written == Approx(b.vector));
+  CHECK(restriction.working_set == Approx(b.transfer + b.vector));
+}
+
+}  // namespace
+
+TEST_CASE("roofline: the V-cycle is counted per level, each part on its own data", "[roofline]") {
+  const Scene scene = test::test_scene("cantilever");
+  ch10::MultigridStepper stepper(scene, {});
+  State state = rest_state(scene);
+  stepper.step(state);
+  const ch10::Multigrid& mg = stepper.multigrid();
+  REQUIRE(mg.levels() >= 2);
+  const int products = ch10::smoother_products(mg);
+  for (const int scalar : {8, 4}) {
+    INFO("scalar " << scalar);
+    const PhaseWork v = ch10::v_cycle_work(ch10::multigrid_levels(mg), products, scalar, false);
+    check_level(v, mg.fine_level(), 0, products, scalar);
+    for (int k = 1; k + 1 < mg.levels(); ++k)
+      check_level(v, mg.coarse_levels()[k - 1], k, products, scalar);
+    // The coarsest level: its dense Cholesky factor, in double whatever the levels' scalar.
+    const auto& coarsest = mg.coarse_levels().back();
+    const PhaseWork& solve =
+        phase(v.parts, "level " + std::to_string(mg.levels() - 1) + " coarsest solve");
+    CHECK(solve.bytes_read == double(coarsest.coarsest_solve.dense.size()) * sizeof(double));
+    // The parts are the whole: nothing counted outside them.
+    double read = 0.0, written = 0.0;
+    for (const PhaseWork& p : v.parts) {
+      CHECK(p.parts.empty());
+      CHECK(p.working_set <= v.working_set);
+      read += p.bytes_read;
+      written += p.bytes_written;
+    }
+    CHECK(read == Approx(v.bytes_read));
+    CHECK(written == Approx(v.bytes_written));
+    CHECK(v.parts.size() == std::size_t(3 * (mg.levels() - 1) + 1));
+  }
+  // In the chapter's solve, every V-cycle part runs once per PCG pass, beside the PCG's own.
+  const ChapterInfo& c10 = find_chapter("10");
+  const auto s10 = c10.make(scene, {});
+  const auto work = stepped_work(c10, *s10, scene, 1);
+  const PhaseWork& solve = phase(work, "solve");
+  const double passes = s10->profile().cg_iterations + 1.0;
+  const auto& m10 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s10)).multigrid();
+  const PhaseWork v = ch10::v_cycle_work(ch10::multigrid_levels(m10), products, 8, false);
+  const PhaseWork& fine = phase(solve.parts, "level 0 smoothing and residual");
+  CHECK(fine.bytes_read == Approx(passes * phase(v.parts, fine.phase).bytes_read));
+  CHECK(phase(solve.parts, "pcg").working_set < solve.working_set);
+  double read = 0.0;
+  for (const PhaseWork& p : solve.parts) read += p.bytes_read;
+  CHECK(read == Approx(solve.bytes_read));
+}
+
 TEST_CASE("roofline: every chapter of the course counts its work through the registry",
           "[roofline]") {
   const Scene scene = test::test_scene("cantilever");
