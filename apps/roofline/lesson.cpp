@@ -83,7 +83,10 @@ void add_roofline_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated, for --other-chapters", "");
   args.option("other-chapters", "LIST", "chapters to place on each of --meshes",
               latest_chapter().id);
-  args.option("threads-max", "N", "the second thread count of the roofs and chapters 09-12",
+  args.option("threads-max", "N",
+              "the second thread count of the roofs and of the chapters whose stepper uses "
+              "threads (09 to " +
+                  latest_chapter().id.substr(0, 2) + ")",
               std::to_string(hardware_threads()));
   args.option("warmup", "N", "unmeasured steps before the measured ones (fem_bench's default)",
               "10");
