@@ -99,6 +99,21 @@ nlohmann::json likwid_json(const LikwidRate& r) {
   return {{"kernel", r.kernel}, {"rate", r.rate}, {"note", r.note}};
 }
 
+// A phase's kernels, each with the level its own working set fits and its bytes' time there.
+nlohmann::json parts_json(const Roofs& roofs, const PhaseWork& w) {
+  nlohmann::json parts = nlohmann::json::array();
+  for (const PhaseWork& p : w.parts)
+    parts.push_back({{"part", p.phase},
+                     {"bytes_read", p.bytes_read},
+                     {"bytes_written", p.bytes_written},
+                     {"bytes_allocated", p.bytes_allocated},
+                     {"flops", p.flops_double + p.flops_float},
+                     {"working_set", p.working_set},
+                     {"level", fitting_levels(roofs, p)},
+                     {"memory_s", memory_seconds(roofs, p)}});
+  return parts;
+}
+
 }  // namespace
 
 std::string roofs_checked(const std::vector<Roofs>& roofs) {
@@ -198,6 +213,16 @@ std::string broken_bounds(const std::vector<PlacedRun>& runs) {
          "machine?), or a level too far out.**\n";
 }
 
+namespace {
+
+const Roofs& roofs_at(const std::vector<Roofs>& roofs, int threads) {
+  for (const Roofs& r : roofs)
+    if (r.threads == threads) return r;
+  return roofs.front();
+}
+
+}  // namespace
+
 std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedRun>& runs,
                       const std::string& provisional) {
   nlohmann::json data = {{"roofs", nlohmann::json::array()}, {"runs", nlohmann::json::array()}};
@@ -238,7 +263,8 @@ std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedR
                         {"bound_s", q.bound_s},
                         {"memory_s", q.memory_s},
                         {"arithmetic_s", q.arithmetic_s},
-                        {"measured_s", q.measured_s}});
+                        {"measured_s", q.measured_s},
+                        {"parts", parts_json(roofs_at(roofs, r.threads), q.work)}});
     data["runs"].push_back({{"chapter", r.chapter},
                             {"mesh", r.mesh},
                             {"threads", r.threads},
