@@ -107,7 +107,9 @@ std::vector<Lesson> lessons() {
                   [](const LessonRun& run) { return roofline_table(run); },
                   true};
   roofline.readme = "docs/roofline.md";
-  roofline.record_args = {"--steps", "20"};
+  // fem_bench's window (10 warm-up and 100 measured steps from rest), so that the book's
+  // roofline and its bench table time the same steps; roofs timed long enough to be quiet.
+  roofline.record_args = {"--steps", "100", "--warmup", "10", "--roof-seconds", "0.5"};
   roofline.record_meshes_if_present = {"meshes/generated/beam_100k.msh"};
   return {roofline};
 }

@@ -1,6 +1,7 @@
 #include "apps/roofline/placement.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 
 #include "common/lesson.hpp"
@@ -89,11 +90,17 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
 std::vector<PlacedRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,
                                      const std::vector<Roofs>& roofs, int warmup, int steps) {
   progress("roofline: " + chapter.id + " on " + mesh_name(scene));
-  const auto stepper = chapter.make(scene, SolverSettings{});
+  std::unique_ptr<Stepper> stepper = chapter.make(scene, SolverSettings{});
+  const bool threaded = stepper->uses_threads();
   std::vector<PlacedRun> runs;
-  for (const Roofs& r : roofs)
-    if (r.threads == 1 || stepper->uses_threads())
-      runs.push_back(measure(chapter, *stepper, scene, r, warmup, steps));
+  for (const Roofs& r : roofs) {
+    if (r.threads > 1 && !threaded) continue;
+    // A fresh stepper per thread count, as fem_bench makes one per run: the steps from rest
+    // then see the same guesses, predictions and adaptive team as the bench's.
+    if (!stepper) stepper = chapter.make(scene, SolverSettings{});
+    runs.push_back(measure(chapter, *stepper, scene, r, warmup, steps));
+    stepper.reset();
+  }
   return runs;
 }
 
