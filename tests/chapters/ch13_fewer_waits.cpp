@@ -4,6 +4,7 @@
 // solves the same systems to the same tolerance in about as many iterations, reaches a tight
 // one, and gives the same state on 1, 2 and 3 threads, also over a long run under a jumping
 // mouse spring; the stepper matches chapter 01 and allocates nothing per step (generic tests).
+#include <memory>
 #include <random>
 
 #include "catch2_compat.hpp"
@@ -102,6 +103,76 @@ TEST_CASE("ch13: the fused V-cycle is chapter 12's to the bit, on every path and
       INFO(s.name << ", default hierarchy, on " << threads << " threads");
       CHECK(fused_against_chapter_12(s, threads, {}) == 0.0);
     }
+}
+
+namespace {
+
+// The barriers the team meets while f() runs (chapter 09's counter: thread 0 counts each).
+template <class F>
+long long barriers_during(F&& f) {
+  const long long before = ch09::sync_counts().barriers.load();
+  f();
+  return ch09::sync_counts().barriers.load() - before;
+}
+
+// The barriers of one step per PCG iteration: the first steps of two steppers that stop
+// after 3 iterations and after 4 (no tolerance reached), subtracted. make(settings) builds one.
+template <class Make>
+long long waits_per_iteration(const Scene& scene, Make&& make) {
+  long long count[2] = {0, 0};
+  for (const int extra : {0, 1}) {
+    SolverSettings settings;
+    settings.tolerance = 1e-14;
+    settings.max_iterations = 3 + extra;
+    const auto stepper = make(settings);
+    stepper->adaptive_team().set_enabled(false);
+    State state = rest_state(scene);
+    count[extra] = barriers_during([&] { stepper->step(state); });
+    REQUIRE(stepper->profile().cg_iterations == settings.max_iterations);
+  }
+  return count[1] - count[0];
+}
+
+}  // namespace
+
+TEST_CASE("ch13: the waits counted, per V-cycle and per PCG iteration, against chapter 12's",
+          "[ch13]") {
+  // theory.md, section 12: a level with s smoothing steps per side costs chapter 12 2s + 3
+  // waits, the coarsest one, the conversions two; the fused cycle saves the conversions, the
+  // first step of each shared level below the finest and the restriction to the coarsest
+  // level (it joins the coarsest solve); the PCG adds four waits per iteration (chapter 09) or one
+  // (the single-reduction PCG, whose update loop also runs the cycle's entry).
+  const Scene scene = test::test_scene("cantilever");
+  const ThreadCountScope scope(openmp_enabled() ? 2 : 1);
+  // Three levels, the finest and the middle one shared by the team: every path of the fusion.
+  const ch10::MultigridStepperSettings mg = three_levels(false);
+  ch12::HalfBytesStepper stepper(scene, {}, ch12::Arithmetic::single, mg);
+  State state = rest_state(scene);
+  stepper.step(state);
+  REQUIRE(stepper.multigrid().levels() == 3);
+  REQUIRE(!stepper.multigrid().fine_level().rows.serial);
+  REQUIRE(!stepper.multigrid().coarse_levels()[0].rows.serial);
+  auto& reduced = dynamic_cast<ch12::ReducedVCycle<float>&>(stepper.v_cycle());
+  ch13::FusedVCycle fused(reduced, stepper.multigrid());
+  const Eigen::VectorXd r = Eigen::VectorXd::Ones(stepper.system_rhs().size());
+  Eigen::VectorXd s(r.size());
+  ch09::run_parallel([&] { fused.prepare(stepper.system_matrix(), ch09::RowChunks{}); });
+  const long long twelve =
+      barriers_during([&] { ch09::run_parallel([&] { reduced.apply({}, r, s); }); });
+  const long long thirteen =
+      barriers_during([&] { ch09::run_parallel([&] { fused.apply({}, r, s); }); });
+  const int steps = ch10::smoothing_steps(reduced.fine_level());
+  REQUIRE(steps == 3);  // chapter 10's default: Chebyshev of degree 3, one sweep
+  INFO("per V-cycle: chapter 12 " << twelve << " waits, chapter 13 " << thirteen);
+  CHECK(twelve == 2 * (2 * steps + 3) + 1 + 2);  // 21
+  CHECK(thirteen == twelve - 4);                 // 17
+  CHECK(waits_per_iteration(scene, [&](const SolverSettings& settings) {
+          return std::make_unique<ch13::FewerWaitsStepper>(scene, settings, mg);
+        }) == thirteen + 1);  // 18
+  CHECK(waits_per_iteration(scene, [&](const SolverSettings& settings) {
+          return std::make_unique<ch12::HalfBytesStepper>(scene, settings, ch12::Arithmetic::single,
+                                                          mg);
+        }) == twelve + 4);  // 25
 }
 
 TEST_CASE("ch13: about chapter 12's iterations at 1e-4, and 1e-10 still reached", "[ch13]") {
