@@ -88,9 +88,6 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> times_inverse_diagonal(
   add_product(out, level.smoother.inverse_diagonal[i], r.data());
   return out.total();
 }
-using ch10::residual;
-using ch10::smooth;
-using ch10::smoothing_steps;
 
 // b_c = R r on coarse rows [first, last), fine rows in increasing order.
 template <class Real, int B>
