@@ -7,7 +7,8 @@ stepper extends chapter 09's instead of copying it), as do the lesson measuremen
 text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
 header's path, "Chapter NN"), so that no hunk is a rename. It also writes the table of each
 chapter's files and what it includes from earlier chapters into chapters/README.md (between
-its chapter-files markers). With --check, writes nothing and exits 1 if a committed diff or
+its chapter-files markers), and the table of which chapter's code runs each phase of each
+chapter's step (its phase-owners markers, docs/phase_owners.py). With --check, writes nothing and exits 1 if a committed diff or
 that table is stale or any hunk only changes names.
 
     fem-tools docs diffs                    # regenerate
@@ -21,6 +22,7 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.course import variant as make_variant
+from femtools.docs import phase_owners
 from femtools.docs.markers import replace_between
 STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
@@ -206,15 +208,18 @@ def main(argv=None, prog=None):
     readme = args.root / "chapters" / "README.md"
     text = readme.read_text() if readme.exists() else ""
     new = with_files_table(text, files_table(dirs))
+    owners = phase_owners.owners_table(dirs, lambda chapter: names(chapter)["class"])
+    new = replace_between(new, phase_owners.MARKER, owners) if new is not None else None
     if new is None:
-        print(f"{readme}: no {FILES_MARKER} markers", file=sys.stderr)
+        print(f"{readme}: no {FILES_MARKER} or {phase_owners.MARKER} markers", file=sys.stderr)
         return 1
     if new != text:
         if args.check:
             stale.append(readme)
         else:
             readme.write_text(new)
-            print(f"wrote the {FILES_MARKER} table of {readme.relative_to(args.root)}")
+            print(f"wrote the {FILES_MARKER} and {phase_owners.MARKER} tables of "
+                  f"{readme.relative_to(args.root)}")
     if renames:
         print("hunks that only change names (normalise them in renamed()):\n  " + "\n  ".join(renames),
               file=sys.stderr)
