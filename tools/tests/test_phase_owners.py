@@ -13,7 +13,8 @@ def owners(root):
     dirs = diffs.chapter_dirs(root)
     info = phase_owners.classes(dirs)
     folders = {d.name[:2]: d for d in dirs}
-    return {d.name[:2]: phase_owners.phase_owners(info, diffs.names(d)["class"], folders) for d in dirs}
+    return {d.name[:2]: phase_owners.phase_owners(info, (d.name[:2], diffs.names(d)["class"]), folders)
+            for d in dirs}
 
 
 def test_the_course_phases_are_followed_to_the_chapter_that_overrides_them():

@@ -45,10 +45,13 @@ def names(chapter):
             "class": match.group(1) if match else ""}
 
 
-def renamed(text, old, new):
-    """text of chapter `old` with the names of chapter `new`."""
-    # Its own stepper.hpp and work.hpp (the registry's files) under its own name.
-    text = re.sub(rf"chapters/{old['id']}/(stepper|work)\.hpp", rf"chapters/{new['id']}/\1.hpp", text)
+def renamed(text, old, new, files=()):
+    """text of chapter `old` with the names of chapter `new`, whose folder holds `files`."""
+    # Its own stepper.hpp and work.hpp (the registry's files), and any header the new chapter
+    # has a file of the same name for (a chapter that starts as a copy of the last), under its
+    # own name.
+    own = "|".join(re.escape(f) for f in sorted({"stepper.hpp", "work.hpp", *files}))
+    text = re.sub(rf"chapters/{old['id']}/({own})\b", rf"chapters/{new['id']}/\1", text)
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
     if old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
@@ -84,7 +87,8 @@ def file_diff(previous, current, name, root):
     if name in ALWAYS_ADDED or not a.exists() or extends:
         return list(difflib.unified_diff([], new_lines, fromfile="/dev/null",
                                          tofile=str(b.relative_to(root))))
-    old_text = renamed(a.read_text(), names(previous), names(current))
+    old_text = renamed(a.read_text(), names(previous), names(current),
+                       [p.name for p in current.iterdir() if p.suffix == ".hpp"])
     return list(difflib.unified_diff(old_text.splitlines(keepends=True), new_lines,
                                      fromfile=str(a.relative_to(root)),
                                      tofile=str(b.relative_to(root))))

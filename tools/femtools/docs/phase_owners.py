@@ -39,8 +39,9 @@ def braced(text, start):
 
 
 def classes(chapter_dirs):
-    """Every class with a public base in the chapters' headers: name -> its chapter folder, its
-    base's name and the methods it declares virtual or override."""
+    """Every class with a public base in the chapters' headers: (chapter number, name) -> its
+    chapter folder, its base's key and the methods it declares virtual or override. (A copied
+    chapter keeps its classes' names: the chapter tells them apart.)"""
     found = {}
     for chapter in chapter_dirs:
         for header in sorted(chapter.glob("*.hpp")):
@@ -50,13 +51,15 @@ def classes(chapter_dirs):
                 methods = {NAME_BEFORE_PARENTHESIS.search(d).group(1) for d in declarations
                            if re.search(r"\b(?:override|virtual)\b", d)
                            and NAME_BEFORE_PARENTHESIS.search(d)}
-                found[m.group(1)] = {"chapter": chapter, "base": m.group(3), "methods": methods}
+                base_number = m.group(2)[2:4] if m.group(2) else chapter.name[:2]
+                found[(chapter.name[:2], m.group(1))] = {"chapter": chapter, "base": (base_number, m.group(3)),
+                                                         "methods": methods}
     return found
 
 
 def definition(info, cls, method):
-    """The body of cls::method in its chapter's sources, or None."""
-    pattern = re.compile(rf"\b{cls}::{method}\s*\([^;{{}}]*\)[^;{{}}]*\{{")
+    """The body of cls::method (cls a key of info) in its chapter's sources, or None."""
+    pattern = re.compile(rf"\b{cls[1]}::{method}\s*\([^;{{}}]*\)[^;{{}}]*\{{")
     for path in sorted(info[cls]["chapter"].glob("*.[hc]pp")):
         text = COMMENT.sub("", path.read_text())
         m = pattern.search(text)
@@ -94,9 +97,10 @@ class Owners:
         for number, function in QUALIFIED.findall(body):
             if number[2:] in self.folders:
                 self.add(self.folders[number[2:]], f"`{function}`")
-        for cls, method in BASE_CALL.findall(body):
-            if cls in self.chain:  # Base::method: the nearest definition from Base down
-                defined = next((c for c in self.chain[self.chain.index(cls):]
+        for name, method in BASE_CALL.findall(body):
+            named = [i for i, c in enumerate(self.chain) if c[1] == name]
+            if named:  # Base::method: the nearest definition from Base down
+                defined = next((c for c in self.chain[named[0]:]
                                 if definition(self.info, c, method) is not None), None)
                 if defined is not None:
                     self.run(defined, method, depth)
@@ -115,7 +119,8 @@ def chain_of(info, stepper):
 
 
 def phase_owners(info, stepper, folders):
-    """Per phase, {chapter number: [what of it runs]} for the stepper class `stepper`;
+    """Per phase, {chapter number: [what of it runs]} for the stepper class `stepper` (a key of
+    info: its chapter's number and its name);
     folders: chapter number -> its folder."""
     chain = chain_of(info, stepper)
     timed = next((c for c in chain if (body := definition(info, c, "step")) and PHASE_BLOCK.search(body)),
@@ -132,7 +137,7 @@ def phase_owners(info, stepper, folders):
         owners.calls(block, 1)
         result[m.group(1)] = owners.found
     preconditioned = next((c for c in chain
-                           if "use_preconditioner(" in (definition(info, c, c) or "")), None)
+                           if "use_preconditioner(" in (definition(info, c, c[1]) or "")), None)
     if preconditioned and "solve" in result:
         result["solve"].setdefault(info[preconditioned]["chapter"].name[:2], []).append("its preconditioner")
     return result
@@ -149,7 +154,7 @@ def owners_table(chapter_dirs, stepper_class):
     folders = {d.name[:2]: d for d in chapter_dirs}
     rows = ["| chapter | " + " | ".join(PHASES) + " |", "| --- |" + " --- |" * len(PHASES)]
     for chapter in chapter_dirs:
-        stepper = stepper_class(chapter)
+        stepper = (chapter.name[:2], stepper_class(chapter))
         owners = phase_owners(info, stepper, folders) if stepper in info else {}
         rows.append(f"| {chapter.name[:2]} | " + " | ".join(cell(owners[p]) if p in owners else "none"
                                                            for p in PHASES) + " |")
