@@ -26,7 +26,7 @@
 #include "chapters/10_multigrid/lesson_options.hpp"
 #include "chapters/10_multigrid/report.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
-#include "common/atomic_file.hpp"
+#include "common/json.hpp"
 #include "common/threads.hpp"
 
 namespace fem::ch10 {
@@ -222,14 +222,15 @@ void export_system(const LessonRun& run, const MultigridStepper& stepper, const 
       !Eigen::saveMarket(Eigen::SparseMatrix<double>(whole_body_modes(scene).sparseView()),
                          dir + "/B.mtx"))
     throw std::runtime_error("cannot write Matrix Market files into '" + dir + "'");
-  std::ostringstream summary;
-  summary << "{\"mesh\": \"" << mesh_name(scene) << "\", \"scene\": \"" << scene.name
-          << "\", \"nodes\": " << scene.mesh.num_nodes() << ", \"tolerance\": " << std::defaultfloat
-          << solver_from_args(run.args).tolerance
-          << ", \"ours_iterations\": " << z.v_cycle.iterations
-          << ", \"block_jacobi_iterations\": " << z.jacobi.iterations
-          << ", \"ours_levels\": " << stepper.multigrid().levels() << "}\n";
-  write_file_atomically(dir + "/summary.json", summary.str());
+  Json summary;
+  summary["mesh"] = mesh_name(scene);
+  summary["scene"] = scene.name;
+  summary["nodes"] = scene.mesh.num_nodes();
+  summary["tolerance"] = solver_from_args(run.args).tolerance;
+  summary["ours_iterations"] = z.v_cycle.iterations;
+  summary["block_jacobi_iterations"] = z.jacobi.iterations;
+  summary["ours_levels"] = stepper.multigrid().levels();
+  write_json_file(dir + "/summary.json", summary);
   std::cerr << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
 }
 

@@ -178,24 +178,15 @@ void Multigrid::factorize(const std::vector<Eigen::Matrix3d>& fine_blocks) {
       build_tentatives();
     }
   });
-  factorize_from(fine_, 0, true);
+  const bool refresh = refresh_rule_.refreshed();
+  auto own = [&](auto& level, std::size_t next, bool collective) {
+    factorize_own(level, next, collective, refresh);
+  };
+  for_levels_from(fine_, coarse_, 0, true, refresh, own);
   // Read by every thread above; written after the last barrier of factorize_from's loops.
   ch09::on_one_thread(true, [&] {
     if (!prolongators_ready_) finish_set_up();
   });
-}
-
-// One level's numbers and, at a refresh, those of the levels below. A small level (serial)
-// and the levels below it run on one thread.
-template <int B>
-void Multigrid::factorize_from(Level<B>& level, std::size_t next, bool collective) {
-  if (collective && level.rows.serial) {
-    ch09::on_one_thread(true, [&] { factorize_from(level, next, false); });
-    return;
-  }
-  const bool refresh = refresh_rule_.refreshed();
-  factorize_own(level, next, collective, refresh);
-  if (refresh && !level.coarsest) factorize_from(coarse_[next], next + 1, collective);
 }
 
 // One level's own part of factorize(): its smoother every time (the coarsest level: its
@@ -248,24 +239,18 @@ void Multigrid::estimate_spectrum(Level<B>& level, bool new_prolongator) {
 
 // ---- every PCG iteration: the V-cycle ---------------------------------------------------------
 
-void Multigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-  refresh_rule_.count_cycle();
-  v_cycle(fine_, coarse_, 0, r, z, true);
-}
+void Multigrid::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) { apply(fine_, coarse_, r, z); }
 
 // ---- for the lesson's costs per level ------------------------------------------------------
 
 void Multigrid::factorize_level(int level, bool refresh) {
-  const auto own = [&](auto& l, std::size_t next) {
-    if (l.rows.serial)
-      ch09::on_one_thread(true, [&] { factorize_own(l, next, false, refresh); });
-    else
-      factorize_own(l, next, true, refresh);
+  auto own = [&](auto& l, std::size_t next, bool collective) {
+    factorize_own(l, next, collective, refresh);
   };
   if (level == 0)
-    own(fine_, 0);
+    for_levels_from(fine_, coarse_, 0, true, false, own);
   else
-    own(coarse_.at(level - 1), level);
+    for_levels_from(coarse_.at(level - 1), coarse_, level, true, false, own);
 }
 
 void Multigrid::cycle_from(int level) {

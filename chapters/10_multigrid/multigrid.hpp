@@ -32,6 +32,7 @@
 #include "chapters/10_multigrid/level.hpp"
 #include "chapters/10_multigrid/refresh_rule.hpp"
 #include "chapters/10_multigrid/smoothers.hpp"
+#include "chapters/10_multigrid/v_cycle.hpp"
 #include "common/scene.hpp"
 
 namespace fem::ch10 {
@@ -91,6 +92,26 @@ class Multigrid {
   // thread of a team (r complete before the call), or outside one.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z);
 
+  // The same two rules for levels of another type that copy this hierarchy's with other
+  // numbers (chapter 12's float levels), which bring only their kernels (v_cycle.hpp):
+  // after factorize(), update(level, collective, refreshed) on the levels it changed, the
+  // finest every time, the coarse ones after a refresh (all of them when `all`), a small level
+  // and those below it on one thread; and one V-cycle on them, counted by the refresh rule.
+  // Same calling rules as factorize() and apply().
+  template <class Fine, class Coarse, class Update>
+  void for_factorized_levels(Fine& fine, std::vector<Coarse>& coarse, bool all, Update&& update) {
+    const bool refreshed = all || refresh_rule_.refreshed();
+    auto work = [&](auto& level, std::size_t, bool collective) {
+      update(level, collective, refreshed);
+    };
+    for_levels_from(fine, coarse, 0, true, refreshed, work);
+  }
+  template <class Fine, class Coarse, class Vector>
+  void apply(Fine& fine, std::vector<Coarse>& coarse, const Vector& r, Vector& z) {
+    refresh_rule_.count_cycle();
+    v_cycle(fine, coarse, 0, r, z, true);
+  }
+
   const MultigridSettings& settings() const { return settings_; }
   // The levels as factorize() left them (level 0: the mesh).
   int levels() const { return 1 + static_cast<int>(coarse_.size()); }
@@ -107,8 +128,6 @@ class Multigrid {
   void cycle_from(int level);
 
  private:
-  template <int B>
-  void factorize_from(Level<B>& level, std::size_t next, bool collective);
   template <int B>
   void factorize_own(Level<B>& level, std::size_t next, bool collective, bool refresh);
   template <int B>

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <Eigen/LU>
+#include <type_traits>
 #include <vector>
 
 #include "chapters/10_multigrid/level.hpp"
@@ -240,18 +241,24 @@ void residual(Level<B>& level, int first, int last, const Eigen::VectorXd& b,
   }
 }
 
-// A level on the same hierarchy with other numbers and a polynomial smoother: the same
-// smoothing steps, the polynomial steps and the plain residual, on its own kernels.
+// A level on the same hierarchy with other numbers and a polynomial smoother derives from
+// PolynomialLevel: a base class's namespace is searched by argument-dependent lookup, so the
+// V-cycle then finds these three for it (the same smoothing steps, the polynomial steps and the
+// plain residual, on its own row_product and times_inverse_diagonal), and no other level does.
+struct PolynomialLevel {};
 template <class L>
+using IfPolynomialLevel = std::enable_if_t<std::is_base_of_v<PolynomialLevel, L>, int>;
+
+template <class L, IfPolynomialLevel<L> = 0>
 int smoothing_steps(const L& level) {
   return static_cast<int>(level.smoother.weights.size()) / 2;
 }
-template <class L, class Vector>
+template <class L, class Vector, IfPolynomialLevel<L> = 0>
 void smooth(L& level, int k, int first, int last, const Vector& b, const Vector* in, Vector& out,
             bool /*forward*/) {
   polynomial_step(level, k, first, last, b, in, out);
 }
-template <class L, class Vector>
+template <class L, class Vector, IfPolynomialLevel<L> = 0>
 void residual(L& level, int first, int last, const Vector& b, const Vector& x) {
   constexpr int B = L::block_size;
   for (int i = first; i < last; ++i)

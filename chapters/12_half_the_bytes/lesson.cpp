@@ -19,10 +19,20 @@ namespace fem::ch12 {
 
 namespace {
 
+// The table's rows: chapter 11's V-cycle in double (no Arithmetic: no float numbers), then
+// chapter 12's float V-cycle in each arithmetic.
+struct Variant {
+  const char* name;
+  std::optional<Arithmetic> arithmetic;
+};
+const Variant kVariants[] = {{"double (chapter 11)", std::nullopt},
+                             {"float", Arithmetic::single},
+                             {"float numbers, double arithmetic", Arithmetic::double_on_float}};
+
 // One variant of the preconditioner: a stepper at the default tolerance (times, iterations)
 // and one at each tight tolerance (iterations), stepped side by side.
 struct Run {
-  std::string name;
+  Variant variant;
   std::unique_ptr<ch11::NodeOrderStepper> stepper;
   std::vector<std::unique_ptr<ch11::NodeOrderStepper>> tight;
   State state;
@@ -32,18 +42,18 @@ struct Run {
   bool converged = true;
 };
 
-std::unique_ptr<ch11::NodeOrderStepper> make(const Scene& scene, int variant, double tolerance) {
+std::unique_ptr<ch11::NodeOrderStepper> make(const Scene& scene, const Variant& variant,
+                                             double tolerance) {
   SolverSettings settings;
   settings.tolerance = tolerance;
-  if (variant == 0) return std::make_unique<ch11::NodeOrderStepper>(scene, settings);
-  return std::make_unique<HalfBytesStepper>(
-      scene, settings, variant == 1 ? Arithmetic::single : Arithmetic::double_on_float);
+  if (!variant.arithmetic) return std::make_unique<ch11::NodeOrderStepper>(scene, settings);
+  return std::make_unique<HalfBytesStepper>(scene, settings, *variant.arithmetic);
 }
 
-double v_cycle_ms(Run& r, int variant) {
+double v_cycle_ms(Run& r) {
   const Eigen::VectorXd rhs = r.stepper->system_rhs();
   Eigen::VectorXd s(rhs.size());
-  if (variant == 0)
+  if (!r.variant.arithmetic)
     return time_ms(
         20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
   auto& v_cycle = static_cast<HalfBytesStepper&>(*r.stepper).v_cycle();
@@ -52,17 +62,17 @@ double v_cycle_ms(Run& r, int variant) {
 }
 
 std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tight) {
-  const char* names[] = {"double (chapter 11)", "float", "float numbers, double arithmetic"};
-  std::vector<Run> runs(3);
-  for (int v = 0; v < 3; ++v) {
-    runs[v].name = names[v];
-    runs[v].stepper = make(run.scene, v, SolverSettings{}.tolerance);
-    runs[v].state = rest_state(run.scene);
+  std::vector<Run> runs;
+  for (const Variant& variant : kVariants) {
+    Run& r = runs.emplace_back();
+    r.variant = variant;
+    r.stepper = make(run.scene, variant, SolverSettings{}.tolerance);
+    r.state = rest_state(run.scene);
     for (const double t : tight) {
-      runs[v].tight.push_back(make(run.scene, v, t));
-      runs[v].tight_state.push_back(runs[v].state);
+      r.tight.push_back(make(run.scene, variant, t));
+      r.tight_state.push_back(r.state);
     }
-    runs[v].tight_iterations.resize(tight.size());
+    r.tight_iterations.resize(tight.size());
   }
   // Interleaved, one step of each in turn; the first two steps set up and are not timed.
   for (int k = 0; k < run.steps + 2; ++k) {
@@ -81,7 +91,7 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
     }
   }
   // Chapter 10's numbers in double take twice the float ones' bytes (the tests check it).
-  auto& single = static_cast<HalfBytesStepper&>(*runs[1].stepper).v_cycle();
+  auto& single = static_cast<HalfBytesStepper&>(*runs[1].stepper).v_cycle();  // Arithmetic::single
   const long long bytes = 2 * static_cast<ReducedVCycle<float>&>(single).number_bytes();
   const double mb = 1e-6 * static_cast<double>(bytes);
   std::ostringstream out;
@@ -92,10 +102,9 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
   out << " |\n| --- | ---: | ---: | ---: | ---:";
   for (std::size_t t = 0; t < tight.size(); ++t) out << " | ---:";
   out << " |\n";
-  for (int v = 0; v < 3; ++v) {
-    Run& r = runs[v];
-    out << "| " << r.name << " | " << fixed(v == 0 ? mb : mb / 2, 2) << " | "
-        << fixed(v_cycle_ms(r, v), 3) << " | " << fixed(median(r.solve_ms), 2) << " | "
+  for (Run& r : runs) {
+    out << "| " << r.variant.name << " | " << fixed(r.variant.arithmetic ? mb / 2 : mb, 2) << " | "
+        << fixed(v_cycle_ms(r), 3) << " | " << fixed(median(r.solve_ms), 2) << " | "
         << median(r.iterations);
     for (const auto& its : r.tight_iterations) out << " | " << median(its);
     out << (r.converged ? "" : " (a solve did not converge)") << " |\n";

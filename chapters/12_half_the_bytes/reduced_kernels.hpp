@@ -19,16 +19,16 @@ namespace fem::ch12 {
 // vector whose length is no multiple of a packet in scalars (Matrix<float, 3, 1>: three
 // scalar multiply-adds per column), so chapter 10's column-by-column form would spend as many
 // instructions on a float block as on a double one, and save only bytes. Here a column of R
-// rows is loaded as Lanes<R> floats (R = 3: 4, the next column's first float in the last
+// rows is loaded as kPaddedColumn<R> floats (R = 3: 4, the next column's first float in the last
 // lane; R = 6: 8) and costs one vector multiply-add; the extra lanes collect harmless
 // products of finite numbers and are dropped. Every array of blocks ends with one padding
 // block, so that the last column's extra floats exist. In Real = double the loaded floats
 // are widened in registers: memory sees float, the arithmetic is double.
 template <int R>
-constexpr int Lanes = R == 3 ? 4 : 8;
+constexpr int kPaddedColumn = R == 3 ? 4 : 8;
 
 template <class Real, int R>
-using Wide = Eigen::Matrix<Real, Lanes<R>, 1>;
+using Wide = Eigen::Matrix<Real, kPaddedColumn<R>, 1>;
 
 // Partial sums of a product, in float one per block column: a block's columns then add into
 // independent registers. With one sum, the C multiply-adds of a block form a chain in which
@@ -57,7 +57,7 @@ struct Sums {
 template <class Real, int R, int C>
 EIGEN_ALWAYS_INLINE void add_product(Sums<Real, R, C>& sums, const Eigen::Matrix<float, R, C>& M,
                                      const Real* x) {
-  using Column = Eigen::Matrix<float, Lanes<R>, 1>;
+  using Column = Eigen::Matrix<float, kPaddedColumn<R>, 1>;
   for (int j = 0; j < C; ++j)
     sums.of(j) += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];
 }
@@ -88,9 +88,6 @@ EIGEN_ALWAYS_INLINE Eigen::Matrix<Real, B, 1> times_inverse_diagonal(
   add_product(out, level.smoother.inverse_diagonal[i], r.data());
   return out.total();
 }
-using ch10::residual;
-using ch10::smooth;
-using ch10::smoothing_steps;
 
 // b_c = R r on coarse rows [first, last), fine rows in increasing order.
 template <class Real, int B>

@@ -8,7 +8,6 @@
 #include <type_traits>
 
 #include "chapters/09_threads/parallel.hpp"
-#include "chapters/10_multigrid/v_cycle.hpp"
 #include "chapters/12_half_the_bytes/reduced_kernels.hpp"
 
 namespace fem::ch12 {
@@ -78,31 +77,24 @@ void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::
   multigrid_.factorize(A.blocks);
   // Everything after a refresh, and the first time (a hierarchy factorized before this object
   // existed); read by every thread after factorize's last barrier, written after convert's.
-  const bool refreshed = multigrid_.refresh_rule().refreshed() || !converted_;
-  convert(fine_, refreshed, true);
+  multigrid_.for_factorized_levels(
+      fine_, coarse_, !converted_,
+      [&](auto& level, bool collective, bool refreshed) { convert(level, refreshed, collective); });
   ch09::on_one_thread(true, [&] { converted_ = true; });
-  if (!refreshed) return;
-  for (auto& level : coarse_) {
-    if (level.source->rows.serial)  // chapter 10 factorizes a small level on one thread: so here
-      ch09::on_one_thread(true, [&] { convert(level, true, false); });
-    else
-      convert(level, true, true);
-  }
 }
 
 template <class Real>
 void ReducedVCycle<Real>::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
                                 Eigen::VectorXd& s) {
-  multigrid_.refresh_rule().count_cycle();  // the refresh rule counts V-cycles
   if constexpr (std::is_same_v<Real, double>) {
-    ch10::v_cycle(fine_, coarse_, 0, r, s, true);
+    multigrid_.apply(fine_, coarse_, r, s);
   } else {
     const std::vector<int>& part = fine_.source->rows.part;
     ch09::for_parts(part, true, [&](int first, int last) {
       r_.segment(3 * first, 3 * (last - first)) =
           r.segment(3 * first, 3 * (last - first)).template cast<float>();
     });
-    ch10::v_cycle(fine_, coarse_, 0, r_, s_, true);
+    multigrid_.apply(fine_, coarse_, r_, s_);
     ch09::for_parts(part, true, [&](int first, int last) {
       s.segment(3 * first, 3 * (last - first)) =
           s_.segment(3 * first, 3 * (last - first)).template cast<double>();

@@ -27,9 +27,10 @@ namespace fem::ch12 {
 using ch10::kModes;
 
 // One level of the hierarchy with the numbers the V-cycle reads in float; the pattern, the
-// row blocks, the refresh rule and the coarsest Cholesky factor stay the source level's.
+// row blocks, the refresh rule and the coarsest Cholesky factor stay the source level's. A
+// PolynomialLevel: chapter 10's polynomial smoothing steps and residual run on its products.
 template <class Real, int B>
-struct ReducedLevel {
+struct ReducedLevel : ch10::PolynomialLevel {
   static constexpr int block_size = B;
   const ch10::Level<B>* source = nullptr;
   std::vector<Eigen::Matrix<float, B, B>> blocks;  // the level's matrix

@@ -208,6 +208,34 @@ TEST_CASE("ch10: zero heap allocations per step after the first, with 2 threads"
   }
 }
 
+TEST_CASE("ch10: serial_rows runs the small levels on one thread, to the same bits", "[ch10]") {
+  // A level with fewer rows than serial_rows, and every level below it, runs on one thread
+  // (for_levels_from and v_cycle): the same sums in the same order, so the same state.
+  const Scene scene = test::test_scene("cantilever");
+  const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
+  const auto run = [&](int serial_rows, State& state) {
+    ch10::MultigridStepperSettings s = three_levels();
+    s.multigrid.rows.serial_rows = serial_rows;
+    ch10::MultigridStepper stepper(scene, {}, s);
+    stepper.adaptive_team().set_enabled(false);
+    state = rest_state(scene);
+    for (int k = 0; k < 20; ++k) stepper.step(state);
+    std::vector<bool> serial = {stepper.multigrid().fine_level().rows.serial};
+    for (const auto& level : stepper.multigrid().coarse_levels())
+      serial.push_back(level.rows.serial);
+    return serial;
+  };
+  const int fine_rows = scene.mesh.num_nodes();
+  State shared, coarse_serial;
+  const std::vector<bool> none = run(0, shared);
+  const std::vector<bool> coarse_only = run(fine_rows, coarse_serial);  // all rows but the fine
+  REQUIRE(none.size() == 3);
+  CHECK(none == std::vector<bool>{false, false, false});
+  CHECK(coarse_only == std::vector<bool>{false, true, true});
+  CHECK(bit_identical(shared.x, coarse_serial.x));
+  CHECK(bit_identical(shared.v, coarse_serial.v));
+}
+
 TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "[ch10]") {
   const Scene scene = test::test_scene("cantilever");
   ch10::MultigridStepper stepper(scene, {});

@@ -144,7 +144,7 @@ EXERCISES = [
      "expect": "measured"},
     {"id": "12/2", "chapter": "12", "name": "ex_unpadded",
      "change": [("reduced_kernels.hpp",
-                 "  using Column = Eigen::Matrix<float, Lanes<R>, 1>;\n  for (int j = 0; j < C; ++j)\n"
+                 "  using Column = Eigen::Matrix<float, kPaddedColumn<R>, 1>;\n  for (int j = 0; j < C; ++j)\n"
                  "    sums.of(j) += Eigen::Map<const Column>(M.data() + R * j).template cast<Real>() * x[j];\n",
                  "  for (int j = 0; j < C; ++j)\n"
                  "    sums.of(j).template head<R>() += M.col(j).template cast<Real>() * x[j];\n")],

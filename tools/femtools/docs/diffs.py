@@ -7,7 +7,8 @@ stepper extends chapter 09's instead of copying it), as do the lesson measuremen
 text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
 header's path, "Chapter NN"), so that no hunk is a rename. It also writes the table of each
 chapter's files and what it includes from earlier chapters into chapters/README.md (between
-its chapter-files markers). With --check, writes nothing and exits 1 if a committed diff or
+its chapter-files markers), and the table of which chapter's code runs each phase of each
+chapter's step (its phase-owners markers, docs/phase_owners.py). With --check, writes nothing and exits 1 if a committed diff or
 that table is stale or any hunk only changes names.
 
     fem-tools docs diffs                    # regenerate
@@ -21,6 +22,7 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.course import variant as make_variant
+from femtools.docs import phase_owners
 from femtools.docs.markers import replace_between
 STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
@@ -43,10 +45,13 @@ def names(chapter):
             "class": match.group(1) if match else ""}
 
 
-def renamed(text, old, new):
-    """text of chapter `old` with the names of chapter `new`."""
-    # Its own stepper.hpp and work.hpp (the registry's files) under its own name.
-    text = re.sub(rf"chapters/{old['id']}/(stepper|work)\.hpp", rf"chapters/{new['id']}/\1.hpp", text)
+def renamed(text, old, new, files=()):
+    """text of chapter `old` with the names of chapter `new`, whose folder holds `files`."""
+    # Its own stepper.hpp and work.hpp (the registry's files), and any header the new chapter
+    # has a file of the same name for (a chapter that starts as a copy of the last), under its
+    # own name.
+    own = "|".join(re.escape(f) for f in sorted({"stepper.hpp", "work.hpp", *files}))
+    text = re.sub(rf"chapters/{old['id']}/({own})\b", rf"chapters/{new['id']}/\1", text)
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
     if old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
@@ -82,7 +87,8 @@ def file_diff(previous, current, name, root):
     if name in ALWAYS_ADDED or not a.exists() or extends:
         return list(difflib.unified_diff([], new_lines, fromfile="/dev/null",
                                          tofile=str(b.relative_to(root))))
-    old_text = renamed(a.read_text(), names(previous), names(current))
+    old_text = renamed(a.read_text(), names(previous), names(current),
+                       [p.name for p in current.iterdir() if p.suffix == ".hpp"])
     return list(difflib.unified_diff(old_text.splitlines(keepends=True), new_lines,
                                      fromfile=str(a.relative_to(root)),
                                      tofile=str(b.relative_to(root))))
@@ -206,15 +212,18 @@ def main(argv=None, prog=None):
     readme = args.root / "chapters" / "README.md"
     text = readme.read_text() if readme.exists() else ""
     new = with_files_table(text, files_table(dirs))
+    owners = phase_owners.owners_table(dirs, lambda chapter: names(chapter)["class"])
+    new = replace_between(new, phase_owners.MARKER, owners) if new is not None else None
     if new is None:
-        print(f"{readme}: no {FILES_MARKER} markers", file=sys.stderr)
+        print(f"{readme}: no {FILES_MARKER} or {phase_owners.MARKER} markers", file=sys.stderr)
         return 1
     if new != text:
         if args.check:
             stale.append(readme)
         else:
             readme.write_text(new)
-            print(f"wrote the {FILES_MARKER} table of {readme.relative_to(args.root)}")
+            print(f"wrote the {FILES_MARKER} and {phase_owners.MARKER} tables of "
+                  f"{readme.relative_to(args.root)}")
     if renames:
         print("hunks that only change names (normalise them in renamed()):\n  " + "\n  ".join(renames),
               file=sys.stderr)

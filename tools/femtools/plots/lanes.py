@@ -58,7 +58,8 @@ def draw_padded_block(ax, rows, lanes, y0, title):
 
 
 def plot_padded_lanes(out):
-    fine, coarse = constant(r"R == 3 \? (\d+) : (\d+)", "Lanes<R> (the padded column's floats)")
+    fine, coarse = constant(r"R == 3 \? (\d+) : (\d+)",
+                            "kPaddedColumn<R> (the padded column's floats)")
     fig, ax = plt.subplots(figsize=(16, 7.6))
     y0 = 0.0
     for rows, lanes in ((3, fine), (6, coarse)):
@@ -71,11 +72,11 @@ def plot_padded_lanes(out):
     ax.set_aspect("equal")
     ax.set_axis_off()
     fig.suptitle("Chapter 12's float V-cycle: each block column read in padded lanes (add_product "
-                 "in reduced_v_cycle.cpp)", fontsize=11)
+                 "in reduced_kernels.hpp)", fontsize=11)
     finish(fig, out / "padded_lanes.png",
            "aIJ: row I, column J of the block, stored column by column; grey: floats "
            "past the column, whose products land in lanes that total() drops. The sums of the "
-           "columns add up at the end. Lane counts read from chapter 12's Lanes<R>. Without the "
+           "columns add up at the end. Lane counts read from chapter 12's kPaddedColumn<R>. Without the "
            "padding, Eigen 3.4 keeps a Matrix<float, 3, 1> in scalars (its packet of 4 floats is longer than the "
            "column): three scalar multiply-adds per column.", top=0.97)
 
