@@ -33,7 +33,8 @@ void add_options(ArgParser& args) {
   args.option("watch", "NODE", "print this node's final position, 17 digits (-1: none)", "-1");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
-              "scene's name there is replaced; a folder another run is writing is refused)",
+              "scene's name there is replaced once the run ends well, kept if it fails; a "
+              "folder another run is writing is refused)",
               "out/sim");
 }
 
@@ -142,15 +143,24 @@ void run_scene(const ArgParser& args, const Run& run) {
   const bool threaded = body.stepper().uses_threads();
   std::cout << "threads: " << (threaded ? run.threads : 1)
             << (threaded ? "" : " (this chapter is single-threaded)") << "\n";
+  // The new series replaces an earlier one only once it is whole (common/vtk.hpp): a run
+  // that fails part-way leaves the earlier series as it was.
   std::optional<VtkSeries> series;
-  if (run.every > 0) {
-    series.emplace(args.get("out"), args.get("scene"));
-    if (series->replaced_frames() > 0)
-      std::cout << "replacing the earlier series '" << args.get("scene") << "' in "
-                << args.get("out") << " (" << series->replaced_frames() << " frames removed)\n";
-  }
+  if (run.every > 0) series.emplace(args.get("out"), args.get("scene"));
   const auto start = std::chrono::steady_clock::now();
-  simulate(run, body, series);
+  try {
+    simulate(run, body, series);
+  } catch (const std::exception& e) {
+    if (!series) throw;
+    throw std::runtime_error(std::string(e.what()) + "\n(nothing of this run written to " +
+                             args.get("out") + ": an earlier series there is as it was)");
+  }
+  if (series) {
+    series->commit();
+    if (series->replaced_frames() > 0)
+      std::cout << "replaced the earlier series '" << args.get("scene") << "' in "
+                << args.get("out") << " (" << series->replaced_frames() << " frames)\n";
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "done in " << seconds << " s";

@@ -60,6 +60,11 @@ bool is_frame_of(const std::string& file, const std::string& name) {
                      [](char c) { return c >= '0' && c <= '9'; });
 }
 
+// The NNNNNN of a frame of the series `name` (is_frame_of).
+long frame_number(const std::string& file, const std::string& name) {
+  return std::stol(file.substr(name.size() + 1, file.size() - name.size() - 5));
+}
+
 }  // namespace
 
 void VtkSeries::check_writable(const std::string& directory) {
@@ -88,15 +93,28 @@ void VtkSeries::check_writable(const std::string& directory) {
 
 VtkSeries::VtkSeries(std::string directory, std::string name)
     : directory_(std::move(directory)), name_(std::move(name)) {
+  namespace fs = std::filesystem;
   std::error_code error;
-  std::filesystem::create_directories(directory_, error);
-  if (error || !std::filesystem::is_directory(directory_))
+  fs::create_directories(directory_, error);
+  if (error || !fs::is_directory(directory_))
     throw std::runtime_error("cannot create the output directory '" + directory_ +
                              "': " + error.message());
-  for (const auto& entry : std::filesystem::directory_iterator(directory_))
-    if (is_frame_of(entry.path().filename().string(), name_) &&
-        std::filesystem::remove(entry.path(), error))
-      ++replaced_frames_;
+  // A staging folder found here is a run's that stopped without its commit (killed): the
+  // caller holds the folder's lock (common/run_lock.hpp), so no live run owns it.
+  staging_ = (fs::path(directory_) / ("." + name_ + ".new")).string();
+  fs::remove_all(staging_, error);
+  if (!fs::create_directory(staging_, error))
+    throw std::runtime_error("cannot create the staging folder '" + staging_ +
+                             "': " + error.message());
+}
+
+VtkSeries::~VtkSeries() {
+  std::error_code error;
+  if (!committed_) std::filesystem::remove_all(staging_, error);
+}
+
+std::string VtkSeries::staging_path(const std::string& file) const {
+  return (std::filesystem::path(staging_) / file).string();
 }
 
 std::string VtkSeries::pvd_path() const {
@@ -106,11 +124,10 @@ std::string VtkSeries::pvd_path() const {
 void VtkSeries::write_frame(double time, const Eigen::Matrix3Xd& rest,
                             const std::vector<Eigen::Vector4i>& tets, const Eigen::VectorXd& x,
                             const Eigen::VectorXd& v) {
-  const std::string file = frame_file(name_, frames());
-  write_file_atomically((std::filesystem::path(directory_) / file).string(),
+  write_file_atomically(staging_path(frame_file(name_, frames())),
                         [&](std::ostream& out) { write_vtu(out, rest, tets, x, v); });
   times_.push_back(time);
-  write_file_atomically(pvd_path(), [&](std::ostream& pvd) {
+  write_file_atomically(staging_path(name_ + ".pvd"), [&](std::ostream& pvd) {
     pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
         << "<Collection>\n";
     for (int f = 0; f < frames(); ++f)
@@ -118,6 +135,29 @@ void VtkSeries::write_frame(double time, const Eigen::Matrix3Xd& rest,
           << "\"/>\n";
     pvd << "</Collection>\n</VTKFile>\n";
   });
+}
+
+void VtkSeries::commit() {
+  namespace fs = std::filesystem;
+  if (committed_ || frames() == 0) return;
+  std::vector<fs::path> earlier;
+  for (const auto& entry : fs::directory_iterator(directory_))
+    if (is_frame_of(entry.path().filename().string(), name_)) earlier.push_back(entry.path());
+  replaced_frames_ = static_cast<int>(earlier.size());
+  const auto move = [&](const std::string& file) {
+    std::error_code error;
+    fs::rename(staging_path(file), fs::path(directory_) / file, error);
+    if (error)
+      throw std::runtime_error("cannot move '" + staging_path(file) + "' into '" + directory_ +
+                               "': " + error.message());
+  };
+  for (int f = 0; f < frames(); ++f) move(frame_file(name_, f));
+  move(name_ + ".pvd");
+  committed_ = true;
+  std::error_code error;
+  for (const fs::path& frame : earlier)
+    if (frame_number(frame.filename().string(), name_) >= frames()) fs::remove(frame, error);
+  fs::remove_all(staging_, error);
 }
 
 }  // namespace fem

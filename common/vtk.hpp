@@ -10,11 +10,18 @@ namespace fem {
 
 class VtkSeries {
  public:
-  // Frames go to directory/name_000000.vtu, ...; the series to directory/name.pvd.
-  // Creates the directory; throws std::runtime_error naming the path if it cannot. An earlier
-  // series of the same name there is replaced: its frames are removed (counted in
-  // replaced_frames()), so the folder never mixes two runs' frames. Other files stay.
+  // Frames go to directory/name_000000.vtu, ...; the series to directory/name.pvd. Creates
+  // the directory; throws std::runtime_error naming the path if it cannot.
+  //
+  // A run that fails part-way (a solve that diverges, a full disk) must not cost the user the
+  // earlier complete series of the same name there: the frames and the .pvd are written into
+  // a hidden staging folder beside them (directory/.name.new, whose .pvd is valid after every
+  // frame) and take the series' names only in commit(). A series destroyed without commit()
+  // removes its staging folder and leaves the directory as it was. Other files stay.
   VtkSeries(std::string directory, std::string name);
+  ~VtkSeries();
+  VtkSeries(const VtkSeries&) = delete;
+  VtkSeries& operator=(const VtkSeries&) = delete;
 
   // Throws std::runtime_error, as the constructor would, when the directory cannot be made or
   // written, and creates nothing: a program checks its output folder before its work and
@@ -27,14 +34,23 @@ class VtkSeries {
                    const std::vector<Eigen::Vector4i>& tets, const Eigen::VectorXd& x,
                    const Eigen::VectorXd& v);
 
+  // The new series takes the place of the earlier one: each frame renamed over the frame of
+  // its number, then the .pvd, then the earlier frames beyond the new count removed (counted
+  // in replaced_frames()). Renames need no space, so a full disk cannot stop it half-way.
+  void commit();
+
   int frames() const { return static_cast<int>(times_.size()); }
+  // The series' .pvd in the directory (it names the new frames once commit() has run).
   std::string pvd_path() const;
   int replaced_frames() const { return replaced_frames_; }
 
  private:
-  std::string directory_, name_;
+  std::string staging_path(const std::string& file) const;
+
+  std::string directory_, name_, staging_;
   std::vector<double> times_;
   int replaced_frames_ = 0;
+  bool committed_ = false;
 };
 
 }  // namespace fem
