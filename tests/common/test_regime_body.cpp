@@ -63,9 +63,11 @@ TEST_CASE("the built-in scenes select the same kind of nodes on the bar as on a 
 
 TEST_CASE("every chapter matches chapter 01 on the perforated bar, both scenes", "[regimes]") {
   const TetMesh mesh = load_mesh(test::mesh_path("perforated_bar_test.msh"));
-  for (const ChapterInfo& chapter : chapters()) {
-    if (chapter.id.rfind("01_", 0) == 0) continue;
-    for (const char* name : {"cantilever", "sliding"})
-      test::check_matches_ch01(chapter.id, test::test_scene(name, mesh));
+  for (const char* name : {"cantilever", "sliding"}) {
+    const Scene scene = test::test_scene(name, mesh);
+    const std::vector<State> ch01_states =
+        test::ch01_trajectory(scene, 50);  // once, not per chapter
+    for (const ChapterInfo& chapter : chapters())
+      if (chapter.id.rfind("01_", 0) != 0) test::check_matches_ch01(chapter.id, scene, ch01_states);
   }
 }
