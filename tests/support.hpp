@@ -186,9 +186,11 @@ inline std::vector<Scene> equivalence_scenes() {
   return {test_scene("cantilever"), test_scene("sliding"), driven_scene()};
 }
 
-// Chapter 01 equivalence on every scene, the driven one included (it checks first that
-// the driven scene really has every filter case and a non-zero z).
-inline void check_matches_ch01_on_every_scene(const std::string& chapter) {
+// Chapter 01 equivalence on the driven scene (it checks first that the scene really has every
+// filter case and a non-zero z). The cantilever and the sliding scene are the generic test's
+// ("NN: matches chapter 01 on both scenes over 50 steps", tests/generic, label chNN too):
+// stepping them here again would double the suite's most expensive check.
+inline void check_matches_ch01_on_driven_scene(const std::string& chapter) {
   const Scene driven = driven_scene();
   int kinds[3] = {0, 0, 0};
   for (const auto& c : driven.constraints) {
@@ -198,7 +200,7 @@ inline void check_matches_ch01_on_every_scene(const std::string& chapter) {
   REQUIRE(kinds[0] > 0);  // plane
   REQUIRE(kinds[1] > 0);  // line
   REQUIRE(kinds[2] > 0);  // fixed
-  for (const Scene& scene : equivalence_scenes()) check_matches_ch01(chapter, scene);
+  check_matches_ch01(chapter, driven);
 }
 
 // Rayleigh mass damping alone on a rigid translation (no gravity, no constraints, no
@@ -255,11 +257,12 @@ inline void check_drift_at_default_tolerance(const std::string& chapter) {
   }
 
 // The tests every chapter after 01 runs, generic over the chapter: equivalence with chapter
-// 01 on every scene (the driven one included), the damping rate, and the drift at the
-// default tolerance. A new chapter's test file starts with FEM_CHAPTER_TESTS("NN", "[chNN]").
+// 01 on the driven scene (on the other two: tests/generic), the damping rate, and the drift
+// at the default tolerance. A new chapter's test file starts with
+// FEM_CHAPTER_TESTS("NN", "[chNN]").
 #define FEM_CHAPTER_TESTS(ID, TAG)                                                                 \
-  TEST_CASE("ch" ID ": matches chapter 01 on the cantilever, sliding and driven scenes", TAG) {    \
-    fem::test::check_matches_ch01_on_every_scene(ID);                                              \
+  TEST_CASE("ch" ID ": matches chapter 01 on the driven scene, every filter case moving", TAG) {   \
+    fem::test::check_matches_ch01_on_driven_scene(ID);                                             \
   }                                                                                                \
   TEST_CASE("ch" ID ": mass damping slows a rigid translation by 1/(1 + h alpha) per step", TAG) { \
     fem::test::check_damping_rate(ID);                                                             \
