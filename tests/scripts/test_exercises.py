@@ -331,9 +331,9 @@ def main():
                 command = ex["test"]
                 check(f"{ex['id']}: the README gives `{command}`", readme_has(chapter_dir, command))
                 # ./tutorial.sh test builds everything first; the copy built what these tests
-                # need, so ctest with the same selection runs them.
+                # need, so ctest with the same selection runs them, side by side as it does.
                 selection = command.replace("./tutorial.sh test", "").replace("NAME", ex["name"]).strip()
-                p = run(repo, f"ctest --preset release {selection}", env)
+                p = run(repo, f"ctest --preset release -j {os.cpu_count() or 1} {selection}", env)
                 ran = re.findall(r"Test +#\d+: (.*?) \.+", p.stdout)
                 check(f"{ex['id']}: `{command}` runs the variant's tests and only those",
                       len(ran) >= 4 and all(name.startswith(variant + ":") for name in ran), p.stdout[-2000:])
