@@ -78,9 +78,9 @@ void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::
   // Everything after a refresh, and the first time (a hierarchy factorized before this object
   // existed); read by every thread after factorize's last barrier, written after convert's.
   multigrid_.for_factorized_levels(
-      fine_, coarse_, !converted_,
+      fine_, coarse_, !converted_.load(std::memory_order_relaxed),
       [&](auto& level, bool collective, bool refreshed) { convert(level, refreshed, collective); });
-  ch09::on_one_thread(true, [&] { converted_ = true; });
+  ch09::on_one_thread(true, [&] { converted_.store(true, std::memory_order_relaxed); });
 }
 
 template <class Real>

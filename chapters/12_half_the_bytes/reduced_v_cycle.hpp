@@ -17,6 +17,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <vector>
 
 #include "chapters/09_threads/parallel_pcg.hpp"
@@ -82,8 +83,11 @@ class ReducedVCycle final : public ch09::Preconditioner {
   ch10::Multigrid& multigrid_;
   ReducedLevel<Real, 3> fine_;
   std::vector<ReducedLevel<Real, kModes>> coarse_;
-  Vector r_, s_;            // the PCG's residual and its preconditioned residual in Real
-  bool converted_ = false;  // the coarse levels, prolongators and weights read once
+  Vector r_, s_;  // the PCG's residual and its preconditioned residual in Real
+  // The coarse levels, prolongators and weights read once. Every thread reads it on entry to
+  // prepare and one thread sets it after: between them stand the conversion's barriers, except
+  // in a one-level hierarchy, which has nothing to convert; atomic, so that case is no data race.
+  std::atomic<bool> converted_{false};
 };
 
 extern template class ReducedVCycle<float>;
