@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A variant of every chapter whose folder holds more than one source file (its stepper and
-the building blocks or lesson it teaches: 02, 03, 04, 07, 08, 09, 10) is made with
+the roofline's work.cpp, and the building blocks or lesson it teaches: today every chapter) is made with
 `fem-tools course variant` in a copy of the repository, built with the rest (every .cpp of a
 chapter's folder is compiled), passes the checks every chapter passes (the generic tests
 under its own name), runs beside its original in one fem_bench run, and its copy of the
