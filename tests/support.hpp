@@ -315,4 +315,19 @@ class JumpingMouse {
   Eigen::Vector3d target_ = Eigen::Vector3d::Zero();
 };
 
+// The soak tests' loop: `steps` steps of `stepper` from `state` under the jumping mouse, ended
+// by the first step that diverges (common/stepper.hpp's divergence: its reason is returned, ""
+// when none does); after every other step `each(k)` records what the test asserts.
+template <class Stepper, class Each>
+std::string soak_under_mouse(Stepper& stepper, JumpingMouse& mouse, State& state, int steps,
+                             Each&& each) {
+  for (int k = 0; k < steps; ++k) {
+    stepper.set_external_forces(mouse.force(k, state));
+    stepper.step(state);
+    if (const char* why = divergence(state, stepper.profile())) return why;
+    each(k);
+  }
+  return "";
+}
+
 }  // namespace fem::test

@@ -182,13 +182,7 @@ SoakResult soak(const std::string& chapter, const Scene& scene, int threads, int
   SoakResult out;
   out.state = rest_state(scene);
   const double rest_energy = total_energy(model, scene, out.state);
-  for (int k = 0; k < steps; ++k) {
-    stepper->set_external_forces(mouse.force(k, out.state));
-    stepper->step(out.state);
-    if (const char* why = divergence(out.state, stepper->profile())) {
-      out.diverged = why;
-      return out;
-    }
+  out.diverged = test::soak_under_mouse(*stepper, mouse, out.state, steps, [&](int k) {
     out.not_converged += stepper->profile().converged ? 0 : 1;
     if (k % 20 == 0) {
       const double energy = std::abs(total_energy(model, scene, out.state) - rest_energy);
@@ -196,7 +190,7 @@ SoakResult soak(const std::string& chapter, const Scene& scene, int threads, int
       // The spring's first 300 steps (a tenth of the full soak, however many steps run).
       if (k < 300) out.max_energy_early = out.max_energy;
     }
-  }
+  });
   return out;
 }
 

@@ -312,18 +312,12 @@ Soak soak(const Scene& scene, int threads, int steps) {
   test::JumpingMouse mouse(scene, 50);
   Soak out;
   out.state = rest_state(scene);
-  for (int k = 0; k < steps; ++k) {
-    stepper.set_external_forces(mouse.force(k, out.state));
-    stepper.step(out.state);
-    if (const char* why = divergence(out.state, stepper.profile())) {
-      out.diverged = why;
-      return out;
-    }
+  out.diverged = test::soak_under_mouse(stepper, mouse, out.state, steps, [&](int k) {
     out.not_converged += stepper.profile().converged ? 0 : 1;
     out.most_iterations = std::max(out.most_iterations, stepper.profile().cg_iterations);
     if (mouse.just_jumped(k, 3) && stepper.multigrid().refresh_rule().refreshed())
       ++out.jump_refreshes;
-  }
+  });
   out.refreshes = stepper.multigrid().refresh_rule().refreshes();
   return out;
 }

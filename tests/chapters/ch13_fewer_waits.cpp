@@ -241,17 +241,11 @@ Soak soak(const Scene& scene, int threads, int steps) {
   test::JumpingMouse mouse(scene, 7);
   Soak out;
   out.state = rest_state(scene);
-  for (int k = 0; k < steps; ++k) {
-    stepper.set_external_forces(mouse.force(k, out.state));
-    stepper.step(out.state);
-    if (const char* why = divergence(out.state, stepper.profile())) {
-      out.diverged = why;
-      return out;
-    }
+  out.diverged = test::soak_under_mouse(stepper, mouse, out.state, steps, [&](int k) {
     out.not_converged += stepper.profile().converged ? 0 : 1;
     out.max_speed = std::max(out.max_speed, out.state.v.cwiseAbs().maxCoeff());
     if (k < 300) out.max_speed_early = out.max_speed;
-  }
+  });
   return out;
 }
 
