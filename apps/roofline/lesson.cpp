@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "apps/roofline/kernels_alone.hpp"
 #include "apps/roofline/placement.hpp"
 #include "apps/roofline/report.hpp"
 #include "chapters/registry.hpp"
@@ -68,14 +69,17 @@ std::string roofline_table(const LessonRun& run) {
     for (const ChapterInfo* c : chapters_of(run.args.get("other-chapters")))
       for (PlacedRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
         runs.push_back(std::move(r));
+  const std::vector<AloneRun> alone =
+      kernels_alone(split(run.args.get("alone-chapters")), run.scene, roofs, runs);
   const std::string provisional = run.args.get("provisional");
-  if (run.data) *run.data = json_data(roofs, runs, provisional);
+  if (run.data) *run.data = with_kernels_alone(json_data(roofs, runs, provisional), alone);
   const std::string banner =
       provisional.empty()
           ? ""
           : "**Provisional data, not a measurement to read: " + provisional + ".**\n\n";
   return banner + roofs_table(roofs) + "\n" + roofs_checked(roofs) + "\n" + chapters_table(runs) +
-         "\n" + phases_table(runs) + broken_bounds(runs) + sentence(run, roofs);
+         "\n" + phases_table(runs) + broken_bounds(runs) + kernels_alone_table(alone) +
+         sentence(run, roofs);
 }
 
 void add_roofline_options(ArgParser& args) {
@@ -91,6 +95,9 @@ void add_roofline_options(ArgParser& args) {
   args.option("warmup", "N", "unmeasured steps before the measured ones (fem_bench's default)",
               "10");
   args.option("roof-seconds", "S", "time per roof kernel", "0.2");
+  args.option("alone-chapters", "LIST",
+              "chapters whose solve's kernels run alone on the scene's mesh (empty: none)",
+              "09,12,13");
   args.flag("no-likwid", "skip likwid-bench's check of the roofs");
   args.option("provisional", "REASON",
               "mark the data provisional (the docs check then warns instead of refusing)", "");
