@@ -11,8 +11,11 @@ import json
 import sys
 
 from femtools.args import command_parser, add_root_option
+from femtools.docs import kernels_alone
 from femtools.docs.markers import replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
+# Sections of a lesson's page written from its data besides its table (where the page has them).
+DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: kernels_alone.section}}
 
 
 def load(path):
@@ -21,6 +24,15 @@ def load(path):
     if missing:
         raise ValueError(f"{path}: no {', '.join(missing)}")
     return data
+
+
+def with_data_sections(text, data):
+    """text (None: a page without the table's markers) with the lesson's data sections written
+    where it has their markers."""
+    for marker, render in DATA_SECTIONS.get(data["lesson"], {}).items():
+        if text is not None:
+            text = replace_between(text, marker, render(data.get("data"))) or text
+    return text
 
 
 def main(argv=None, prog=None):
@@ -37,7 +49,7 @@ def main(argv=None, prog=None):
         data = load(path)
         readme = args.root / data["readme"]
         text = readme.read_text()
-        new = replace_between(text, data["marker"], data["table"])
+        new = with_data_sections(replace_between(text, data["marker"], data["table"]), data)
         if new is None:
             problems.append(f"{data['readme']} has no {data['marker']} markers (from {path.name})")
         elif new != text:

@@ -1,0 +1,43 @@
+"""The roofline's remainder, named (`fem_lessons roofline`'s data "kernels_alone", written by
+apps/roofline/kernels_alone.cpp): per chapter and thread count, the solve's measured time, its
+bound, its dominant kernels run alone on data already in the cache, and the solve's time beyond
+its bound in two: in the core (the kernels alone beyond their own bound) and between the kernels
+(the solve beyond its kernels alone and the rest's bound). `fem-tools docs lessons` writes it
+between the markers roofline-kernels-alone of the lesson's page; data recorded before the
+measurement existed give a line that says so."""
+from femtools.docs.markdown import ms, table
+
+MARKER = "roofline-kernels-alone"
+NOT_RECORDED = ("*Not recorded: the committed roofline data predate the kernels alone "
+                "(`./tutorial.sh roofline` records them).*\n")
+
+
+def run_name(r):
+    return f"`{r['chapter']}@{r['threads']}`"
+
+
+def kernels_cell(r):
+    """Each kernel alone: its share of its own bound (the bound over the time it took)."""
+    return "; ".join(f"{k['kernel']} {100 * k['bound_s'] / max(k['seconds'], 1e-12):.0f}%"
+                     for k in r["kernels"])
+
+
+def larger(r):
+    """Which of the two halves of the remainder is the larger one."""
+    return "in the core" if r["in_core_s"] >= r["between_s"] else "between the kernels"
+
+
+def section(data):
+    """The Markdown between the markers, from the lesson's data (a dict, or None)."""
+    runs = (data or {}).get("kernels_alone")
+    if not runs:
+        return NOT_RECORDED
+    rows = [[run_name(r), ms(1e3 * r["solve_s"]), ms(1e3 * r["solve_bound_s"]),
+             f"{ms(1e3 * r['alone_s'])} ({ms(1e3 * r['parts_bound_s'])})", ms(1e3 * r["in_core_s"]),
+             ms(1e3 * r["between_s"]), ms(1e3 * r["waiting_s"]), kernels_cell(r)] for r in runs]
+    header = ["chapter", "solve, ms", "its bound, ms", "kernels alone, ms (their bound)",
+              "in the core, ms", "between the kernels, ms", "waiting (whole step), ms",
+              "each kernel alone: of its bound"]
+    larger_part = "; ".join(f"{run_name(r)} {larger(r)}" for r in runs)
+    return (table(header, rows, ["---"] + ["---:"] * 6 + ["---"]) +
+            f"\nThe larger part of each solve's remainder, on this machine: {larger_part}.\n")
