@@ -224,12 +224,12 @@ AloneRun measure_alone(const ChapterInfo& chapter, const Scene& scene, const Roo
 
 }  // namespace
 
-std::vector<AloneRun> kernels_alone(const std::vector<std::string>& chapters, const Scene& scene,
-                                    const std::vector<Roofs>& roofs,
+std::vector<AloneRun> kernels_alone(const std::vector<const ChapterInfo*>& chapters,
+                                    const Scene& scene, const std::vector<Roofs>& roofs,
                                     const std::vector<PlacedRun>& runs) {
   std::vector<AloneRun> out;
-  for (const std::string& id : chapters) {
-    const ChapterInfo& chapter = find_chapter(id);
+  for (const ChapterInfo* c : chapters) {
+    const ChapterInfo& chapter = *c;
     for (const Roofs& r : roofs) {
       const PlacedRun* run = placed(runs, chapter.id, mesh_name(scene), r.threads);
       if (!run || run->phases.empty()) continue;  // not placed at this count, or not counted

@@ -54,10 +54,10 @@ struct AloneRun {
   double waiting_s = 0.0;      // the step's waiting (the placement's, all phases)
 };
 
-// Each of `chapters` (ids or numbers) placed in `runs` on `scene`, at each thread count of
-// `roofs`: a fresh stepper, a few steps, then its solve's kernels alone under those roofs.
-std::vector<AloneRun> kernels_alone(const std::vector<std::string>& chapters, const Scene& scene,
-                                    const std::vector<Roofs>& roofs,
+// Each of `chapters` placed in `runs` on `scene`, at each thread count of `roofs`: a fresh
+// stepper, a few steps, then its solve's kernels alone under those roofs.
+std::vector<AloneRun> kernels_alone(const std::vector<const ChapterInfo*>& chapters,
+                                    const Scene& scene, const std::vector<Roofs>& roofs,
                                     const std::vector<PlacedRun>& runs);
 
 // The table (Markdown) and a sentence on how to read it; empty when there is nothing.

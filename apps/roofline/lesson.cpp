@@ -58,8 +58,10 @@ std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
 
 std::string roofline_table(const LessonRun& run) {
   const int warmup = run.args.get_int("warmup");
-  // Loaded first: a bad path fails before any measurement.
+  // Loaded first: a bad path or chapter fails before any measurement.
   const std::vector<Scene> others = more_meshes(run);
+  const std::vector<const ChapterInfo*> alone_chapters =
+      chapters_of(run.args.get("alone-chapters"));
   const std::vector<Roofs> roofs = machine_roofs(run);
   std::vector<PlacedRun> runs;
   for (const ChapterInfo* c : chapters_of(run.args.get("chapters")))
@@ -69,8 +71,7 @@ std::string roofline_table(const LessonRun& run) {
     for (const ChapterInfo* c : chapters_of(run.args.get("other-chapters")))
       for (PlacedRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
         runs.push_back(std::move(r));
-  const std::vector<AloneRun> alone =
-      kernels_alone(split(run.args.get("alone-chapters")), run.scene, roofs, runs);
+  const std::vector<AloneRun> alone = kernels_alone(alone_chapters, run.scene, roofs, runs);
   const std::string provisional = run.args.get("provisional");
   if (run.data) *run.data = with_kernels_alone(json_data(roofs, runs, provisional), alone);
   const std::string banner =
@@ -96,7 +97,8 @@ void add_roofline_options(ArgParser& args) {
               "10");
   args.option("roof-seconds", "S", "time per roof kernel", "0.2");
   args.option("alone-chapters", "LIST",
-              "chapters whose solve's kernels run alone on the scene's mesh (empty: none)",
+              "chapters whose solve's kernels run alone on the scene's mesh (ids, numbers or all; "
+              "empty: none)",
               "09,12,13");
   args.flag("no-likwid", "skip likwid-bench's check of the roofs");
   args.option("provisional", "REASON",

@@ -127,7 +127,7 @@ TEST_CASE("roofline: a placed solve beside its kernels alone", "[roofline]") {
   solve.bound_s = bound_seconds(roofs, s.solve);
   solve.measured_s = 1.0;
   run.phases = {solve};
-  const std::vector<AloneRun> alone = kernels_alone({"12"}, scene, {roofs}, {run});
+  const std::vector<AloneRun> alone = kernels_alone({&chapter}, scene, {roofs}, {run});
   REQUIRE(alone.size() == 1);
   const AloneRun& a = alone.front();
   CHECK(a.kernels.size() == 3);
