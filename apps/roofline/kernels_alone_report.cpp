@@ -45,7 +45,8 @@ std::string kernels_alone_table(const std::vector<AloneRun>& runs) {
     for (const KernelAlone& k : r.kernels)
       out << "| " << name(r) << " | " << k.name << " | " << fixed(k.calls, 0) << " | "
           << us(k.seconds) << " | " << us(k.bound_s) << " | "
-          << fixed(100 * k.bound_s / std::max(k.seconds, 1e-12), 0) << "% | "
+          << fixed(100 * k.bound_s / std::max(k.seconds, 1e-12), 0)
+          << (k.bound_s > k.seconds ? "% (faster than its bound) | " : "% | ")
           << ms(k.calls * k.seconds) << " |\n";
   out << "\n| chapter | solve, ms | its bound | the kernels alone (their parts' bound) | in the "
          "core | between the kernels | waiting (whole step) |\n| --- | ---: | ---: | ---: | ---: "

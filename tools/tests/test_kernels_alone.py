@@ -31,7 +31,10 @@ def test_a_row_per_run_from_its_numbers():
     rows = [line for line in text.splitlines() if line.startswith("| `")]
     assert len(rows) == 2
     assert rows[0].startswith("| `12_half_the_bytes@1` | 7.000 | 1.500 | 4.000 (1.000) | 3.000 | 1.000 |")
-    assert "product q = A p 25%" in rows[0]
+    assert rows[0].endswith("| product q = A p 25% |")
+    fast = run("09_threads", 1, 0.0, 1e-3)
+    fast["kernels"][0]["seconds"] = 5e-6
+    assert "product q = A p 200% (faster than its bound)" in kernels_alone.section({"kernels_alone": [fast]})
     assert "`12_half_the_bytes@1` in the core; `09_threads@2` between the kernels." in text
 
 
