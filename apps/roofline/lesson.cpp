@@ -1,5 +1,6 @@
 #include "apps/roofline/lesson.hpp"
 
+#include <iostream>
 #include <sstream>
 
 #include "apps/roofline/kernels_alone.hpp"
@@ -72,6 +73,8 @@ std::string roofline_table(const LessonRun& run) {
       for (PlacedRun& r : place_chapter(*c, scene, roofs, warmup, run.steps))
         runs.push_back(std::move(r));
   const std::vector<AloneRun> alone = kernels_alone(alone_chapters, run.scene, roofs, runs);
+  // Printed here, not in the table: the page shows it in its own section (roofline-kernels-alone).
+  std::cout << kernels_alone_table(alone) << "\n";
   const std::string provisional = run.args.get("provisional");
   if (run.data) *run.data = with_kernels_alone(json_data(roofs, runs, provisional), alone);
   const std::string banner =
@@ -79,8 +82,7 @@ std::string roofline_table(const LessonRun& run) {
           ? ""
           : "**Provisional data, not a measurement to read: " + provisional + ".**\n\n";
   return banner + roofs_table(roofs) + "\n" + roofs_checked(roofs) + "\n" + chapters_table(runs) +
-         "\n" + phases_table(runs) + broken_bounds(runs) + kernels_alone_table(alone) +
-         sentence(run, roofs);
+         "\n" + phases_table(runs) + broken_bounds(runs) + sentence(run, roofs);
 }
 
 void add_roofline_options(ArgParser& args) {
