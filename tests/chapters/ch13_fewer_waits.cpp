@@ -10,6 +10,7 @@
 #include "catch2_compat.hpp"
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
+#include "chapters/13_fewer_waits/lesson.hpp"
 #include "chapters/13_fewer_waits/stepper.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
@@ -267,4 +268,41 @@ TEST_CASE("ch13: soak, thousands of steps under a jumping mouse spring, 1 and 2 
   }
   CHECK(bit_identical(one.state.x, two.state.x));
   CHECK(bit_identical(one.state.v, two.state.v));
+}
+
+TEST_CASE("ch13: the iterations lesson's counts, per setting, the same on 1 and 2 threads",
+          "[ch13]") {
+  // fem_lessons iterations: each setting's mean PCG iterations per step and the roofline's
+  // bytes per iteration. The counts are the stepper's (deterministic, on any thread count);
+  // a smoother of higher degree reads more bytes per iteration and takes fewer iterations.
+  const Scene scene = test::test_scene("cantilever");
+  const auto cost = [&](auto change, int threads) {
+    ch10::MultigridStepperSettings s;
+    change(s.multigrid);
+    const ThreadCountScope scope(threads);
+    return ch13::iteration_cost(scene, {}, s, 5, 20);
+  };
+  const auto same = [](ch10::MultigridSettings&) {};
+  const auto degree2 = [](ch10::MultigridSettings& s) { s.relax.chebyshev_degree = 2; };
+  const auto degree4 = [](ch10::MultigridSettings& s) { s.relax.chebyshev_degree = 4; };
+  const auto unsmoothed = [](ch10::MultigridSettings& s) {
+    s.coarsening.smooth_prolongator = false;
+  };
+  const ch13::IterationCost base = cost(same, 1), two = cost(same, 2), low = cost(degree2, 1),
+                            high = cost(degree4, 1), plain = cost(unsmoothed, 1);
+  INFO("mean iterations: degree 3 " << base.mean_iterations << ", degree 2 " << low.mean_iterations
+                                    << ", degree 4 " << high.mean_iterations << ", P = T "
+                                    << plain.mean_iterations);
+  CHECK(two.mean_iterations == base.mean_iterations);
+  CHECK(two.bytes_per_step == base.bytes_per_step);
+  // Iterations in all over the 20 counted steps.
+  CHECK(20 * base.mean_iterations == Approx(68).margin(1e-9));
+  CHECK(20 * low.mean_iterations == Approx(90).margin(1e-9));
+  CHECK(20 * high.mean_iterations == Approx(55).margin(1e-9));
+  CHECK(20 * plain.mean_iterations == Approx(81).margin(1e-9));
+  CHECK(low.bytes_per_iteration < base.bytes_per_iteration);
+  CHECK(base.bytes_per_iteration < high.bytes_per_iteration);
+  CHECK(plain.bytes_per_iteration < base.bytes_per_iteration);
+  // Per step: the iterations' bytes and, once, the finest level's conversion to float.
+  CHECK(base.bytes_per_step > base.mean_iterations * base.bytes_per_iteration);
 }
