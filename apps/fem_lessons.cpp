@@ -96,8 +96,8 @@ void check_json_writable(const std::string& path) {
   }
 }
 
-// The lesson's table, on one thread unless the lesson measures threads; a run on a busy
-// machine says so under the table (and on stderr).
+// The lesson's table, on one thread unless the lesson measures threads; a timed lesson's run
+// on a busy machine says so under the table (and on stderr).
 std::string measure(const Lesson& lesson, const LessonRun& run) {
   LoadMonitor load;
   std::string table;
@@ -108,7 +108,7 @@ std::string measure(const Lesson& lesson, const LessonRun& run) {
     table = lesson.table(run);
   }
   load.stop();
-  if (!load.busy()) return table;
+  if (!lesson.timed || !load.busy()) return table;
   std::cerr << "fem_lessons " << lesson.name << ": " << load.warning() << "\n";
   return table + "\n**Measured on a busy machine:** " + load.warning() + "\n";
 }

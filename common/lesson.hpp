@@ -38,6 +38,9 @@ struct Lesson {
   // False: the table is measured on one thread (OpenMP's and Eigen's counts at 1), as the
   // chapters before 09 run; true: at the thread counts the lesson chooses (--threads).
   bool uses_threads = false;
+  // False: the table holds counts only (iterations, bytes), which a busy machine does not
+  // change, so fem_lessons adds no busy-machine warning under it.
+  bool timed = true;
   // Where the table goes (between its markers): empty for its chapter's README; a lesson of
   // the whole course (the roofline) names its page.
   std::string readme = "";
