@@ -133,6 +133,17 @@ def options_table(mesh, rows, tol, steps, scene):
     return "\n".join(lines) + "\n"
 
 
+def export_system(args, name, folder):
+    """Chapter 10 for --steps steps on the mesh, its last filtered system written into folder;
+    returns chapter 10's summary of it."""
+    print(f"{name}: chapter 10 for {args.steps} steps, export", file=sys.stderr, flush=True)
+    subprocess.run([args.tool, "multigrid", "--mesh", str(mesh_path(name)), "--scene", args.scene,
+                    "--steps", str(args.steps), "--tol", str(args.tol),
+                    "--modes", str(args.modes), "--threads", "1", "--export", str(folder)],
+                   check=True, stdout=subprocess.DEVNULL)
+    return json.loads((folder / "summary.json").read_text())
+
+
 def main(argv=None, prog=None):
     parser = command_parser(prog, __doc__)
     parser.add_argument("--tool", default=str(ROOT / "build" / "release" / "fem_lessons"))
@@ -155,21 +166,15 @@ def main(argv=None, prog=None):
                      "--target fem_lessons)")
 
     if args.options and (args.readme or args.json):
-        parser.error("--options prints its table only: leave --readme and --json out")
+        parser.error("--options prints its table only: leave out --readme and --json")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.meshes.split(","):
             folder = pathlib.Path(tmp) / name
-            print(f"{name}: chapter 10 for {args.steps} steps, export", file=sys.stderr, flush=True)
-            subprocess.run([args.tool, "multigrid", "--mesh", str(mesh_path(name)), "--scene", args.scene,
-                            "--steps", str(args.steps), "--tol", str(args.tol),
-                            "--modes", str(args.modes), "--threads", "1", "--export", str(folder)],
-                           check=True, stdout=subprocess.DEVNULL)
-            ours = json.loads((folder / "summary.json").read_text())
+            ours = export_system(args, name, folder)
             if args.options:
-                print(f"{name}: PyAMG's options", file=sys.stderr, flush=True)
-                print(options_table(name, pyamg_options(folder, args.tol), args.tol, args.steps,
-                                    args.scene), end="")
+                rows = pyamg_options(folder, args.tol)
+                print(options_table(name, rows, args.tol, args.steps, args.scene), end="")
                 return 0
             print(f"{name}: PyAMG", file=sys.stderr, flush=True)
             iterations, levels, complexity = pyamg_iterations(folder, args.tol, args.modes)
