@@ -51,8 +51,12 @@ std::vector<Setting> settings() {
           {"degree 2", degree(2)},
           {"degree 4", degree(4)},
           {"[lambda/60, lambda]", ratio(60.0)},
+          {"degree 2, [lambda/10, lambda]",
+           [](MultigridSettings& s) {
+             s.relax.chebyshev_degree = 2;
+             s.relax.chebyshev_ratio = 10.0;
+           }},
           {"damped Jacobi, 3 sweeps", jacobi(3)},
-          {"coarsest <= 50 (4 levels)", coarsest(50)},
           {"coarsest <= 1000 (2 levels)", coarsest(1000)},
           {"3 modes (translations)", [](MultigridSettings& s) { s.coarsening.modes = 3; }},
           {"unsmoothed P = T", unsmoothed},
