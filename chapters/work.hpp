@@ -75,17 +75,12 @@ struct ExecutedWork {
   double rotation_iterations = 0.0;  // Newton iterations they took (fallbacks excluded)
   double rotation_fallbacks = 0.0;   // rotations Newton left to the SVD
   double team = 0.0;  // threads the last step ran on (an adaptive team may take one); 0: not said
-  double regions = 0.0;   // parallel regions opened (with more than one thread)
-  double barriers = 0.0;  // barriers met (a team's counted once)
+  // (The synchronizations are counted per phase, in the StepProfile: PhaseCost.)
 
   ExecutedWork since(const ExecutedWork& before) const {
-    return {steps - before.steps,
-            rotations - before.rotations,
+    return {steps - before.steps, rotations - before.rotations,
             rotation_iterations - before.rotation_iterations,
-            rotation_fallbacks - before.rotation_fallbacks,
-            team,
-            regions - before.regions,
-            barriers - before.barriers};
+            rotation_fallbacks - before.rotation_fallbacks, team};
   }
 };
 

@@ -10,6 +10,7 @@
 namespace fem {
 
 long long (*allocation_count_hook)() = nullptr;
+Synchronizations (*sync_count_hook)() = nullptr;
 
 Stepper::Stepper(const Scene& scene) : f_ext_(3 * scene.mesh.num_nodes()) {
   set_external_forces(scene.external_forces);

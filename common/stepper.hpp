@@ -10,14 +10,18 @@
 
 #include "common/allocation_hook.hpp"
 #include "common/scene.hpp"
+#include "common/sync_hook.hpp"
 
 namespace fem {
 
-// What one phase of a step cost: time, and heap allocations when the allocation counter
-// is linked into the program (tests, benchmarks); zero allocations otherwise.
+// What one phase of a step cost: time, heap allocations when the allocation counter is
+// linked into the program (tests, benchmarks; zero otherwise), and the synchronizations its
+// threads met (chapter 09 on; zero before): parallel regions opened, barriers met, a team's
+// counted once. The roofline prices the last two at their measured costs (the phase's waiting).
 struct PhaseCost {
   double seconds = 0.0;
   long long allocations = 0;
+  long long regions = 0, barriers = 0;
 };
 
 // What a preconditioned CG reports about one solve (chapters 06 on).
@@ -122,14 +126,22 @@ std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const S
 // roofline lesson reads the data structures it holds.
 const Stepper& unwrapped(const Stepper& stepper);
 
-// Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`.
+// Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`. Made and
+// ended outside the parallel regions (on the thread that steps), so the synchronizations
+// between are the phase's. Two relaxed loads per hook at each end: nothing beside a phase.
 class PhaseTimer {
  public:
   explicit PhaseTimer(PhaseCost& cost)
-      : cost_(cost), allocations_(count_allocations()), start_(Clock::now()) {}
+      : cost_(cost),
+        allocations_(count_allocations()),
+        syncs_(count_syncs()),
+        start_(Clock::now()) {}
   ~PhaseTimer() {
     cost_.seconds = std::chrono::duration<double>(Clock::now() - start_).count();
     cost_.allocations = count_allocations() - allocations_;
+    const Synchronizations now = count_syncs();
+    cost_.regions = now.regions - syncs_.regions;
+    cost_.barriers = now.barriers - syncs_.barriers;
   }
   PhaseTimer(const PhaseTimer&) = delete;
   PhaseTimer& operator=(const PhaseTimer&) = delete;
@@ -139,8 +151,12 @@ class PhaseTimer {
   static long long count_allocations() {
     return allocation_count_hook ? allocation_count_hook() : 0;
   }
+  static Synchronizations count_syncs() {
+    return sync_count_hook ? sync_count_hook() : Synchronizations{};
+  }
   PhaseCost& cost_;
   long long allocations_;
+  Synchronizations syncs_;
   Clock::time_point start_;
 };
 

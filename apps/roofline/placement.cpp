@@ -11,13 +11,10 @@ namespace fem::roofline {
 
 namespace {
 
-// The measured seconds of each StepProfile phase the work counts name.
-double phase_seconds(const StepProfile& p, const std::string& phase) {
-  if (phase == "forces") return p.forces.seconds;
-  if (phase == "dfdx") return p.dfdx.seconds;
-  if (phase == "compose") return p.compose.seconds;
-  if (phase == "constraints") return p.constraints.seconds;
-  if (phase == "solve") return p.solve.seconds;
+// A StepProfile phase by its name in the results ("forces", ..., "step").
+const PhaseCost& phase_cost(const StepProfile& p, const std::string& phase) {
+  for (const StepProfile::Phase& entry : StepProfile::phases())
+    if (phase == entry.name) return p.*entry.cost;
   throw std::logic_error("no phase '" + phase + "' in StepProfile");
 }
 
@@ -28,9 +25,45 @@ ExecutedWork per_step(ExecutedWork e, int steps) {
   e.rotations /= n;
   e.rotation_iterations /= n;
   e.rotation_fallbacks /= n;
-  e.regions /= n;
-  e.barriers /= n;
   return e;  // the team is the last step's
+}
+
+// What one phase of the measured steps did: its median time, and its synchronizations and
+// their waiting per step (means: each step's count priced at the team that step ran on).
+struct PhaseRecord {
+  double seconds = 0.0, regions = 0.0, barriers = 0.0, waiting_s = 0.0;
+};
+PhaseRecord record_phase(const std::string& phase, const std::vector<StepProfile>& profiles,
+                         const std::vector<int>& teams, const Roofs& roofs) {
+  PhaseRecord out;
+  std::vector<double> seconds;
+  for (std::size_t k = 0; k < profiles.size(); ++k) {
+    const PhaseCost& cost = phase_cost(profiles[k], phase);
+    seconds.push_back(cost.seconds);
+    out.regions += double(cost.regions);
+    out.barriers += double(cost.barriers);
+    out.waiting_s += waiting_seconds(roofs, teams[k], double(cost.regions), double(cost.barriers));
+  }
+  const double n = double(std::max<std::size_t>(profiles.size(), 1));
+  out.seconds = median(seconds);
+  out.regions /= n;
+  out.barriers /= n;
+  out.waiting_s /= n;
+  return out;
+}
+
+PhasePoint place_phase(const PhaseWork& w, const PhaseRecord& record, const Roofs& roofs) {
+  PhasePoint point;
+  point.work = w;
+  point.level = fitting_levels(roofs, w);
+  point.memory_s = memory_seconds(roofs, w);
+  point.arithmetic_s = arithmetic_seconds(roofs, w);
+  point.regions = record.regions;
+  point.barriers = record.barriers;
+  point.waiting_s = record.waiting_s;
+  point.bound_s = bound_seconds(roofs, w) + point.waiting_s;
+  point.measured_s = record.seconds;
+  return point;
 }
 
 // The stepper at the roofs' thread count: `warmup` steps, then `steps` measured.
@@ -45,6 +78,7 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
   run.threads = roofs.threads;
   State state = rest_state(scene);
   std::vector<StepProfile> profiles;
+  std::vector<int> teams;  // the threads each measured step ran on (0: not said)
   const auto executed = [&] {
     return chapter.work.executed ? chapter.work.executed(stepper) : ExecutedWork{};
   };
@@ -54,33 +88,24 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
     stepper.step(state);
     if (k < warmup) continue;
     profiles.push_back(stepper.profile());
-    const int team = static_cast<int>(executed().team);
-    run.team_min = k == warmup ? team : std::min(run.team_min, team);
-    run.team_max = std::max(run.team_max, team);
+    teams.push_back(static_cast<int>(executed().team));
+    run.team_min = k == warmup ? teams.back() : std::min(run.team_min, teams.back());
+    run.team_max = std::max(run.team_max, teams.back());
   }
   run.executed = per_step(executed().since(before), steps);
-  run.waiting_s = run.executed.regions * roofs.region_s + run.executed.barriers * roofs.barrier_s;
-  std::vector<double> iterations, step;
-  for (const StepProfile& p : profiles) {
-    iterations.push_back(p.cg_iterations);
-    step.push_back(p.step.seconds);
-  }
+  const PhaseRecord step = record_phase("step", profiles, teams, roofs);
+  run.step_s = step.seconds;
+  run.regions = step.regions;
+  run.barriers = step.barriers;
+  run.waiting_s = step.waiting_s;
+  std::vector<double> iterations;
+  for (const StepProfile& p : profiles) iterations.push_back(p.cg_iterations);
   run.iterations = median(iterations);
-  run.step_s = median(step);
   if (!chapter.work.count) return run;  // measured, not counted
-  const std::vector<PhaseWork> work =
-      chapter.work.count(stepper, scene, WorkCounts{run.iterations, run.executed});
-  for (const PhaseWork& w : work) {
-    std::vector<double> seconds;
-    for (const StepProfile& p : profiles) seconds.push_back(phase_seconds(p, w.phase));
-    const PhasePoint point{w,
-                           fitting_levels(roofs, w),
-                           bound_seconds(roofs, w),
-                           memory_seconds(roofs, w),
-                           arithmetic_seconds(roofs, w),
-                           median(seconds)};
-    run.bound_s += point.bound_s;
-    run.phases.push_back(point);
+  for (const PhaseWork& w :
+       chapter.work.count(stepper, scene, WorkCounts{run.iterations, run.executed})) {
+    run.phases.push_back(place_phase(w, record_phase(w.phase, profiles, teams, roofs), roofs));
+    run.bound_s += run.phases.back().bound_s;
   }
   return run;
 }

@@ -14,10 +14,12 @@ namespace fem::roofline {
 struct PhasePoint {
   PhaseWork work;
   std::string level;          // where its working set fits: "L1", ..., "memory", or "L2+L3"
-  double bound_s = 0.0;       // bound_seconds: the longer of the two below
+  double bound_s = 0.0;       // max(memory_s, arithmetic_s) + waiting_s (roofs.hpp: held_by)
   double memory_s = 0.0;      // its bytes (or its parts') at the roofs of their levels
   double arithmetic_s = 0.0;  // its flops at the peaks
-  double measured_s = 0.0;    // the median of the measured steps
+  double regions = 0.0, barriers = 0.0;  // its synchronizations per measured step (measured)
+  double waiting_s = 0.0;   // those at their measured costs on the team each step ran on
+  double measured_s = 0.0;  // the median of the measured steps
 };
 
 // One chapter at one thread count under the roofs.
@@ -29,9 +31,10 @@ struct PlacedRun {
   int team_min = 0,
       team_max = 0;  // threads the measured steps ran on (0: the stepper does not say)
   std::vector<PhasePoint> phases;
-  double step_s = 0.0;     // median step
-  double bound_s = 0.0;    // sum of the phases' bounds
-  double waiting_s = 0.0;  // the step's regions and barriers at their measured costs
+  double step_s = 0.0;                   // median step
+  double bound_s = 0.0;                  // sum of the phases' bounds
+  double regions = 0.0, barriers = 0.0;  // the step's synchronizations per measured step
+  double waiting_s = 0.0;  // those at their measured costs: the sum of the phases' waiting
 };
 
 // `chapter` on `scene` under each of `roofs` (one per thread count; a chapter that does not

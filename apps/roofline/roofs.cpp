@@ -74,4 +74,14 @@ double bound_seconds(const Roofs& roofs, const PhaseWork& work) {
   return std::max(memory_seconds(roofs, work), arithmetic_seconds(roofs, work));
 }
 
+double waiting_seconds(const Roofs& roofs, int team, double regions, double barriers) {
+  if (team == 1) return 0.0;
+  return regions * roofs.region_s + barriers * roofs.barrier_s;
+}
+
+const char* held_by(double memory_s, double arithmetic_s, double waiting_s) {
+  if (waiting_s > std::max(memory_s, arithmetic_s)) return "waiting";
+  return memory_s >= arithmetic_s ? "bytes" : "flops";
+}
+
 }  // namespace fem::roofline

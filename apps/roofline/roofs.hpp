@@ -47,7 +47,8 @@ const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 // The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.
 std::string fitting_levels(const Roofs& roofs, const PhaseWork& work);
 
-// The time the roofs allow a phase: its bytes read at the read roof and its bytes written at
+// The time the roofs allow a phase's bytes and flops (its bound adds its waiting, held_by):
+// its bytes read at the read roof and its bytes written at
 // the write roof of the level its working set fits (the write roof's stores allocate their
 // lines as the phase's do), or its flops at the peak (double and float flops each at their
 // own), the longer. A phase made of parts: the sum of each part's bytes at the roofs of the
@@ -56,5 +57,16 @@ double bound_seconds(const Roofs& roofs, const PhaseWork& work);
 // Its two parts: the bytes' time and the flops' time.
 double memory_seconds(const Roofs& roofs, const PhaseWork& work);
 double arithmetic_seconds(const Roofs& roofs, const PhaseWork& work);
+
+// The least time `regions` parallel regions and `barriers` barriers take at their measured
+// costs (barrier_s, region_s) on a team of `team` threads: none on one thread (nothing to
+// wait for; the adaptive team's other choice), the roofs' costs on any other team (a stepper
+// that does not say its team, 0, runs on the roofs' count).
+double waiting_seconds(const Roofs& roofs, int team, double regions, double barriers);
+
+// Which of a phase's three least times holds it, the largest: "bytes", "flops" or "waiting".
+// The phase's bound is max(bytes, flops) + waiting: the bytes and the flops overlap (a core
+// computes while its loads are in flight), a barrier waits for both to end on every thread.
+const char* held_by(double memory_s, double arithmetic_s, double waiting_s);
 
 }  // namespace fem::roofline

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <vector>
 
+#include "common/sync_hook.hpp"
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -19,11 +21,19 @@ namespace fem::ch09 {
 // relaxed add from one thread per barrier: nanoseconds beside the barrier's own cost.
 struct SyncCounts {
   std::atomic<long long> regions{0}, barriers{0};
+
+  Synchronizations snapshot() const {
+    return {regions.load(std::memory_order_relaxed), barriers.load(std::memory_order_relaxed)};
+  }
 };
 inline SyncCounts& sync_counts() {
   static SyncCounts counts;
   return counts;
 }
+// PhaseTimer's hook (common/sync_hook.hpp), set before main by every program that links code
+// which counts, so that each phase of a step carries its own count (StepProfile).
+inline const bool sync_count_hook_set = (
+    sync_count_hook = [] { return sync_counts().snapshot(); }, true);
 inline void count_barrier() {
 #ifdef _OPENMP
   if (omp_get_thread_num() != 0) return;

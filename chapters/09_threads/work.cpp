@@ -7,8 +7,6 @@ namespace fem::ch09 {
 ExecutedWork executed_work(const ThreadsStepper& stepper) {
   ExecutedWork e = ch08::executed_work(stepper);
   e.team = stepper.adaptive_team().team();
-  e.regions = double(sync_counts().regions.load(std::memory_order_relaxed));
-  e.barriers = double(sync_counts().barriers.load(std::memory_order_relaxed));
   return e;
 }
 

@@ -4,7 +4,9 @@
 
 #include "catch2_compat.hpp"
 #include "chapters/08_element_kernels/stepper.hpp"
+#include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/stepper.hpp"
+#include "chapters/registry.hpp"
 #include "common/model.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
@@ -150,6 +152,59 @@ TEST_CASE("ch09: the adaptive team switches to one thread when that is faster, a
   off.set_enabled(false);
   CHECK(run(off, 100, 5.0, 1.0) == 0);
   CHECK(off.next(1) == 1);
+}
+
+namespace {
+
+// The synchronizations the counter saw during f() (chapter 09's SyncCounts).
+template <class F>
+Synchronizations syncs_during(F&& f) {
+  const Synchronizations before = ch09::sync_counts().snapshot();
+  f();
+  const Synchronizations after = ch09::sync_counts().snapshot();
+  return {after.regions - before.regions, after.barriers - before.barriers};
+}
+
+}  // namespace
+
+TEST_CASE("ch09: each phase counts its own synchronizations, and they add up to the step's",
+          "[ch09]") {
+  // PhaseTimer reads chapter 09's counter through the hook that parallel.hpp sets: the phases
+  // cover the step but for the update (no wait), so their counts sum to the step's, and the
+  // step's is what the counter saw. Chapters before 09 open no region and meet no barrier.
+  REQUIRE(sync_count_hook != nullptr);
+  const Scene scene = test::test_scene("cantilever");
+  const ThreadCountScope scope(openmp_enabled() ? 2 : 1);
+  for (const ChapterInfo& chapter : chapters()) {
+    if (!chapter.variant_of.empty()) continue;
+    INFO(chapter.id);
+    const auto stepper = chapter.make(scene, {});
+    if (auto* threads = dynamic_cast<ch09::ThreadsStepper*>(stepper.get()))
+      threads->adaptive_team().set_enabled(false);  // the team of two on every step
+    State state = rest_state(scene);
+    stepper->step(state);
+    const Synchronizations seen = syncs_during([&] { stepper->step(state); });
+    const StepProfile& p = stepper->profile();
+    long long regions = 0, barriers = 0;
+    p.for_each_phase([&](const char* name, const PhaseCost& cost) {
+      if (std::string(name) == "step") return;
+      regions += cost.regions;
+      barriers += cost.barriers;
+    });
+    CHECK(regions == p.step.regions);
+    CHECK(barriers == p.step.barriers);
+    CHECK(p.step.regions == seen.regions);
+    CHECK(p.step.barriers == seen.barriers);
+    if (!stepper->uses_threads()) {
+      CHECK(p.step.barriers == 0);
+      CHECK(p.step.regions == 0);
+      continue;
+    }
+    // Every PCG iteration ends worksharing loops (a barrier each): at least one per iteration.
+    CHECK(p.solve.barriers >= p.cg_iterations);
+    CHECK(p.forces.barriers >= 1);
+    if (openmp_enabled()) CHECK(p.solve.regions >= 1);
+  }
 }
 
 TEST_CASE("ch09: --threads style errors: a count below 1 is refused", "[ch09]") {

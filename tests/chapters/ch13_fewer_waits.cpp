@@ -116,22 +116,31 @@ long long barriers_during(F&& f) {
   return ch09::sync_counts().barriers.load() - before;
 }
 
-// The barriers of one step per PCG iteration: the first steps of two steppers that stop
-// after 3 iterations and after 4 (no tolerance reached), subtracted. make(settings) builds one.
+// The barriers of the first step of a stepper that stops after `iterations` PCG iterations
+// (no tolerance reached), as the counter saw them, and as its solve phase counted them
+// (StepProfile: the step's own count is the counter's). make(settings) builds one.
+struct StepWaits {
+  long long step = 0, solve = 0;
+};
+template <class Make>
+StepWaits waits_of_step(const Scene& scene, Make&& make, int iterations) {
+  SolverSettings settings;
+  settings.tolerance = 1e-14;
+  settings.max_iterations = iterations;
+  const auto stepper = make(settings);
+  stepper->adaptive_team().set_enabled(false);
+  State state = rest_state(scene);
+  const long long seen = barriers_during([&] { stepper->step(state); });
+  REQUIRE(stepper->profile().cg_iterations == iterations);
+  CHECK(stepper->profile().step.barriers == seen);
+  return {seen, stepper->profile().solve.barriers};
+}
+
+// The barriers of one step per PCG iteration: steps that stop after 3 iterations and after 4,
+// subtracted.
 template <class Make>
 long long waits_per_iteration(const Scene& scene, Make&& make) {
-  long long count[2] = {0, 0};
-  for (const int extra : {0, 1}) {
-    SolverSettings settings;
-    settings.tolerance = 1e-14;
-    settings.max_iterations = 3 + extra;
-    const auto stepper = make(settings);
-    stepper->adaptive_team().set_enabled(false);
-    State state = rest_state(scene);
-    count[extra] = barriers_during([&] { stepper->step(state); });
-    REQUIRE(stepper->profile().cg_iterations == settings.max_iterations);
-  }
-  return count[1] - count[0];
+  return waits_of_step(scene, make, 4).step - waits_of_step(scene, make, 3).step;
 }
 
 }  // namespace
@@ -174,6 +183,30 @@ TEST_CASE("ch13: the waits counted, per V-cycle and per PCG iteration, against c
           return std::make_unique<ch12::HalfBytesStepper>(scene, settings, ch12::Arithmetic::single,
                                                           mg);
         }) == twelve + 4);  // 25
+}
+
+TEST_CASE("ch13: the solve phase counts its iterations' waits: iterations x the waits of one",
+          "[ch13]") {
+  // What the roofline prices per phase (StepProfile's solve.barriers): the single-reduction
+  // PCG's solve meets, per iteration, the fused V-cycle's 17 waits on the three-level hierarchy
+  // and its own one (the test above), plus what each solve meets once, whatever its iterations
+  // (the set-up, the first residual): the same for 2 to 6 iterations.
+  const Scene scene = test::test_scene("cantilever");
+  const ThreadCountScope scope(openmp_enabled() ? 2 : 1);
+  const ch10::MultigridStepperSettings mg = three_levels(false);
+  const auto make = [&](const SolverSettings& settings) {
+    return std::make_unique<ch13::FewerWaitsStepper>(scene, settings, mg);
+  };
+  const long long per_iteration = waits_per_iteration(scene, make);
+  REQUIRE(per_iteration > 0);  // 18: checked against the theory in the test above
+  const long long once = waits_of_step(scene, make, 2).solve - 2 * per_iteration;
+  CHECK(once >= 0);
+  for (const int iterations : {3, 4, 6}) {
+    INFO(iterations << " iterations");
+    const StepWaits waits = waits_of_step(scene, make, iterations);
+    CHECK(waits.solve == once + iterations * per_iteration);
+    CHECK(waits.solve < waits.step);  // the other phases wait too
+  }
 }
 
 TEST_CASE("ch13: about chapter 12's iterations at 1e-4, and 1e-10 still reached", "[ch13]") {

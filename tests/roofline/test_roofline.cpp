@@ -1,9 +1,12 @@
 // The work counts (each chapter's work.hpp, through the registry's hook) against the data
 // structures they count, computed here independently from the stepper's objects; the flops
-// of the element pass against the iterations the kernel counted; and the working sets of the
-// roofs. No timing is asserted: the roofs' second measurement is reported by the lesson
-// (fem_lessons roofline), not tested.
+// of the element pass against the iterations the kernel counted; the working sets of the
+// roofs; and each phase's waiting against its own synchronizations. No timing is asserted:
+// the roofs' second measurement is reported by the lesson (fem_lessons roofline), not tested.
+#include <cstdlib>
+
 #include "apps/roofline/bandwidth.hpp"
+#include "apps/roofline/placement.hpp"
 #include "catch2_compat.hpp"
 #include "chapters/01_naive/work.hpp"
 #include "chapters/07_block_sparse/work.hpp"
@@ -304,23 +307,75 @@ TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roo
   }
 }
 
-TEST_CASE("roofline: a threaded step counts its team and its synchronizations", "[roofline]") {
+namespace {
+
+// Roofs made by hand: one level (memory) and the costs of one barrier and one region, so that
+// what the placement prices is known exactly.
+roofline::Roofs hand_roofs(int threads) {
+  roofline::Roofs roofs;
+  roofs.threads = threads;
+  roofline::LevelRoof memory;
+  memory.level = {"memory", 0, 1 << 20};
+  memory.read = 10e9;
+  memory.write = 5e9;
+  roofs.levels = {memory};
+  roofs.peak_double = 20e9;
+  roofs.peak_float = 40e9;
+  roofs.barrier_s = threads > 1 ? 1e-6 : 0.0;
+  roofs.region_s = threads > 1 ? 4e-6 : 0.0;
+  return roofs;
+}
+
+}  // namespace
+
+TEST_CASE("roofline: each phase's waiting is its own synchronizations at their costs",
+          "[roofline]") {
+  // The adaptive team off (chapter 09 reads FEM_ADAPTIVE_TEAM when a stepper is made): every
+  // measured step on the team of two, so every count is priced at the two-thread costs.
+  const char* adaptive = std::getenv("FEM_ADAPTIVE_TEAM");
+  const std::string saved = adaptive ? adaptive : "";
+  setenv("FEM_ADAPTIVE_TEAM", "0", 1);
   const Scene scene = test::test_scene("cantilever");
-  const ChapterInfo& chapter = find_chapter("09");
-  const auto stepper = chapter.make(scene, {});
-  auto* threads = dynamic_cast<ch09::ThreadsStepper*>(stepper.get());
-  REQUIRE(threads);
-  threads->adaptive_team().set_enabled(false);  // the given team on every step
-  const ThreadCountScope team(2);
-  State state = rest_state(scene);
-  stepper->step(state);
-  REQUIRE(chapter.work.executed);
-  const ExecutedWork before = chapter.work.executed(*stepper);
-  stepper->step(state);
-  const ExecutedWork e = chapter.work.executed(*stepper).since(before);
-  CHECK(e.team == 2.0);
-  CHECK(e.steps == 1.0);
-  CHECK(e.regions >= 1.0);
-  // Every PCG iteration ends worksharing loops (a barrier each): at least one per iteration.
-  CHECK(e.barriers >= stepper->profile().cg_iterations);
+  const int threads = openmp_enabled() ? 2 : 1;
+  const roofline::Roofs roofs = hand_roofs(threads);
+  const auto runs = roofline::place_chapter(find_chapter("13"), scene, {roofs}, 1, 3);
+  adaptive ? setenv("FEM_ADAPTIVE_TEAM", saved.c_str(), 1) : unsetenv("FEM_ADAPTIVE_TEAM");
+  REQUIRE(runs.size() == 1);
+  const roofline::PlacedRun& run = runs.front();
+  CHECK(run.team_min == threads);
+  CHECK(run.team_max == threads);
+  REQUIRE(run.phases.size() >= 4);
+  double regions = 0.0, barriers = 0.0, waiting = 0.0;
+  for (const roofline::PhasePoint& p : run.phases) {
+    INFO(p.work.phase);
+    CHECK(p.waiting_s == Approx(p.regions * roofs.region_s + p.barriers * roofs.barrier_s));
+    CHECK(p.bound_s == Approx(std::max(p.memory_s, p.arithmetic_s) + p.waiting_s));
+    const std::string held = roofline::held_by(p.memory_s, p.arithmetic_s, p.waiting_s);
+    CHECK(held == (p.waiting_s > std::max(p.memory_s, p.arithmetic_s) ? "waiting"
+                   : p.memory_s >= p.arithmetic_s                     ? "bytes"
+                                                                      : "flops"));
+    regions += p.regions;
+    barriers += p.barriers;
+    waiting += p.waiting_s;
+  }
+  // The phases cover the step but for the update: their counts are the step's.
+  CHECK(regions == Approx(run.regions));
+  CHECK(barriers == Approx(run.barriers));
+  CHECK(waiting == Approx(run.waiting_s));
+  const roofline::PhasePoint& solve = run.phases.back();
+  REQUIRE(solve.work.phase == "solve");
+  CHECK(solve.barriers >= run.iterations);  // a barrier or more per PCG iteration
+  if (threads > 1) CHECK(solve.waiting_s > 0.0);
+}
+
+TEST_CASE("roofline: one thread waits for nothing, and the largest term holds a phase",
+          "[roofline]") {
+  const roofline::Roofs roofs = hand_roofs(2);
+  // The adaptive team's step on one thread: its barriers are counted, and cost nothing.
+  CHECK(roofline::waiting_seconds(roofs, 1, 3, 100) == 0.0);
+  CHECK(roofline::waiting_seconds(roofs, 2, 3, 100) == Approx(3 * 4e-6 + 100 * 1e-6));
+  CHECK(roofline::waiting_seconds(roofs, 0, 3, 100) == Approx(3 * 4e-6 + 100 * 1e-6));
+  CHECK(std::string(roofline::held_by(2.0, 1.0, 0.5)) == "bytes");
+  CHECK(std::string(roofline::held_by(1.0, 2.0, 0.5)) == "flops");
+  CHECK(std::string(roofline::held_by(1.0, 2.0, 3.0)) == "waiting");
 }

@@ -2,8 +2,10 @@
 """fem-tools plots roofline --check on copies of the committed roofline data
 (docs/data/lessons/roofline.json): with every measured time at least its bound it passes;
 one phase measured below its bound (above 100% of it) is refused, and named; a phase without
-its bytes written is refused; the same data marked provisional pass with a warning. Prints
-'N passed, M failed' last."""
+its bytes written is refused; the same data marked provisional pass with a warning. The same
+checks on the data turned into the format with each phase's waiting (data["bound"]): it passes
+and draws; a phase without its waiting, or whose bound is not max(bytes, flops) + waiting, or
+whose "held by" is not its largest term, is refused. Prints 'N passed, M failed' last."""
 import copy
 import json
 import pathlib
@@ -22,11 +24,52 @@ def check(name, condition, detail=""):
           flush=True)
 
 
-def run_check(record, folder, name):
+def run_check(record, folder, name, *args):
     path = pathlib.Path(folder) / name
     path.write_text(json.dumps(record))
-    return subprocess.run([sys.executable, "-m", "femtools", "plots", "roofline", str(path), "--check"],
-                          capture_output=True, text=True)
+    return subprocess.run([sys.executable, "-m", "femtools", "plots", "roofline", str(path),
+                           *(args or ("--check",))], capture_output=True, text=True)
+
+
+def with_waiting(record):
+    """The record as fem_lessons roofline writes it now: each phase's synchronizations (a few
+    barriers per phase, priced at the record's own barrier cost), its waiting, its bound
+    max(bytes, flops) + waiting and the largest of the three; measured at twice the bound."""
+    out = copy.deepcopy(record)
+    data = out["data"]
+    data["bound"] = "max(memory_s, arithmetic_s) + waiting_s"
+    barrier = {roof["threads"]: roof["barrier_s"] for roof in data["roofs"]}
+    for r in data["runs"]:
+        for k, p in enumerate(r["phases"]):
+            p["regions"], p["barriers"] = 1.0, 100.0 * (k + 1)
+            p["waiting_s"] = p["barriers"] * barrier[r["threads"]]
+            p["bound_s"] = max(p["memory_s"], p["arithmetic_s"]) + p["waiting_s"]
+            terms = {"bytes": p["memory_s"], "flops": p["arithmetic_s"]}
+            p["held_by"] = "waiting" if p["waiting_s"] > max(terms.values()) else max(terms, key=terms.get)
+            p["measured_s"] = 2 * p["bound_s"]
+    return out
+
+
+def check_with_waiting(base, folder):
+    new = with_waiting(base)
+    out = run_check(new, folder, "new.json")
+    check("data with each phase's waiting pass", out.returncode == 0, out.stderr + out.stdout)
+    held = [p["held_by"] for r in new["data"]["runs"] for p in r["phases"]]
+    check("... and some phase there is held by waiting", "waiting" in held, held)
+    png = pathlib.Path(folder) / "new.png"
+    out = run_check(new, folder, "new.json", "--out", str(png))
+    check("... and draw", out.returncode == 0 and png.exists() and png.stat().st_size > 0, out.stderr)
+    for name, change, expect in (
+            ("without its waiting", lambda p: p.pop("waiting_s"), "waiting_s"),
+            ("whose bound leaves out its waiting", lambda p: p.update(bound_s=p["bound_s"] - p["waiting_s"]),
+             "is not max"),
+            ("whose 'held by' is not its largest term", lambda p: p.update(held_by="flops"), "held by flops")):
+        broken = copy.deepcopy(new)
+        phase = next(p for r in broken["data"]["runs"] for p in r["phases"]
+                     if p["held_by"] != "flops" and p["waiting_s"] > 0)
+        change(phase)
+        out = run_check(broken, folder, "broken_new.json")
+        check(f"a phase {name} is refused", out.returncode == 1 and expect in out.stderr, out.stderr)
 
 
 def main():
@@ -54,6 +97,7 @@ def main():
         provisional["data"]["provisional"] = "a test"
         out = run_check(provisional, folder, "provisional.json")
         check("provisional data pass with a warning", out.returncode == 0 and "warning" in out.stderr, out.stderr)
+        check_with_waiting(base, folder)
     print(f"{results['passed']} passed, {results['failed']} failed")
     return 1 if results["failed"] else 0
 

@@ -9,10 +9,16 @@ roof per level, after the DRAM roofline of Williams, Waterman & Patterson (CACM 
     fem-tools plots roofline results/roofline.json --out results/roofline.png
     fem-tools plots roofline docs/data/lessons/roofline.json --check
 
+A phase's bound is max(bytes' time, flops' time) + its waiting (its parallel regions and
+barriers, counted per phase, at their measured costs), as the data's "bound" says; the plot rings
+the phases that waiting holds (the largest of the three). Data recorded before the phases counted
+their waiting have no "bound": read with no waiting, and --check says to re-record them.
+
 --check draws nothing: it exits 1 if a phase ran faster than its bound allows (measured time
-below the bound: the model is broken there, and committed data must not hold one), or if the
-data lack a field the plot and the page read; data recorded with `fem_lessons roofline
---provisional REASON` (a placeholder, the page says so in bold) get warnings instead.
+below the bound: the model is broken there, and committed data must not hold one), if the data
+lack a field the plot and the page read, or if a phase's bound or "held by" is not the one its
+terms give; data recorded with `fem_lessons roofline --provisional REASON` (a placeholder, the
+page says so in bold) get warnings instead.
 """
 import json
 import pathlib
@@ -28,6 +34,28 @@ from femtools.results.phases import marker, parts
 
 PHASE_FIELDS = ("phase", "bytes_read", "bytes_written", "bytes_allocated", "flops_double", "flops_float",
                 "working_set", "level", "bound_s", "memory_s", "arithmetic_s", "measured_s")
+# Each phase's own synchronizations, their waiting and which of the three holds it: in data that
+# say how the bound combines them (data["bound"]).
+WAITING_FIELDS = ("regions", "barriers", "waiting_s", "held_by")
+BOUND = "max(memory_s, arithmetic_s) + waiting_s"
+
+
+def held_by(p):
+    """Which of a phase's three least times holds it (apps/roofline/roofs.cpp's held_by)."""
+    bytes_s, flops_s, waiting_s = p["memory_s"], p["arithmetic_s"], p.get("waiting_s", 0.0)
+    if waiting_s > max(bytes_s, flops_s):
+        return "waiting"
+    return "bytes" if bytes_s >= flops_s else "flops"
+
+
+def bound_problem(p):
+    """Why a phase's bound and "held by" are not the ones its terms give, or None."""
+    expected = max(p["memory_s"], p["arithmetic_s"]) + p["waiting_s"]
+    if abs(p["bound_s"] - expected) > 1e-9 * max(expected, 1e-12):
+        return f"bound {p['bound_s']:.6g} s is not {BOUND} = {expected:.6g} s"
+    if p["held_by"] != held_by(p):
+        return f"held by {p['held_by']}, but its largest term is {held_by(p)}"
+    return None
 
 
 def traffic(p):
@@ -35,19 +63,30 @@ def traffic(p):
     return p["bytes_read"] + p["bytes_written"] + p["bytes_allocated"]
 
 
+def phase_problem(p, with_waiting):
+    """Why --check refuses one phase, or None."""
+    missing = [f for f in PHASE_FIELDS + (WAITING_FIELDS if with_waiting else ()) if f not in p]
+    if missing:
+        return f"no {', '.join(missing)}"
+    return bound_problem(p) if with_waiting else None
+
+
 def problems(data):
-    """What --check refuses: missing fields, and phases measured faster than their bound."""
+    """What --check refuses: missing fields, bounds not made of their terms, and phases measured
+    faster than their bound."""
     found = []
     for roof in data.get("roofs", []):
         for level in roof["levels"]:
             if "write" not in level:
                 found.append(f"roofs at {roof['threads']} thread(s): level {level['name']} has no write roof")
+    if "bound" in data and data["bound"] != BOUND:
+        found.append(f"the bound is {data['bound']!r}; this check knows {BOUND!r}")
     for r in data.get("runs", []):
         name = f"{r['chapter']}@{r['threads']} on {r['mesh']}"
         for p in r["phases"]:
-            missing = [f for f in PHASE_FIELDS if f not in p]
-            if missing:
-                found.append(f"{name} {p.get('phase', '?')}: no {', '.join(missing)}")
+            problem = phase_problem(p, "bound" in data)
+            if problem:
+                found.append(f"{name} {p.get('phase', '?')}: {problem}")
             elif p["measured_s"] < p["bound_s"]:
                 found.append(f"{name} {p['phase']}: measured {p['measured_s'] * 1e3:.3g} ms, below its bound "
                              f"{p['bound_s'] * 1e3:.3g} ms ({100 * p['bound_s'] / p['measured_s']:.0f}% of the "
@@ -87,8 +126,11 @@ def points(ax, runs, threads):
                 continue
             hollow = meshes.index(r["mesh"]) > 0  # a further mesh: hollow markers
             c = colours[r["chapter"]]
-            ax.scatter(flops / traffic(p), flops / p["measured_s"] / 1e9, marker=MARKERS.get(p["phase"], "x"),
-                       s=28, facecolors="none" if hollow else c, edgecolors=c, linewidths=1)
+            x, y = flops / traffic(p), flops / p["measured_s"] / 1e9
+            ax.scatter(x, y, marker=MARKERS.get(p["phase"], "x"), s=28, facecolors="none" if hollow else c,
+                       edgecolors=c, linewidths=1)
+            if held_by(p) == "waiting":
+                ax.scatter(x, y, marker="o", s=110, facecolors="none", edgecolors="C3", linewidths=0.8)
     return chapters, colours, meshes
 
 
@@ -97,6 +139,7 @@ def legend(fig, chapters, colours, meshes):
     handles += [plt.Line2D([], [], ls="", marker=m, color="0.3", label=p) for p, m in MARKERS.items()]
     handles += [plt.Line2D([], [], ls="", marker="o", color="0.3", label=meshes[0])]
     handles += [plt.Line2D([], [], ls="", marker="o", mfc="none", color="0.3", label=m) for m in meshes[1:]]
+    handles += [plt.Line2D([], [], ls="", marker="o", ms=9, mfc="none", color="C3", label="held by waiting")]
     fig.legend(handles=handles, loc="center right", fontsize=7, frameon=False)
 
 
@@ -110,6 +153,9 @@ def check(path, data):
     if provisional:
         print(f"{path}: provisional data ({provisional}): re-record it before it is read")
         return 0
+    if "bound" not in data:
+        print(f"{path}: recorded before each phase counted its waiting (no \"bound\"): read with no "
+              "waiting; re-record it (fem_lessons roofline)")
     if not found:
         print(f"{path}: every phase at or under its bound")
     return 1 if found else 0
