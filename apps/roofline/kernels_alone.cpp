@@ -190,10 +190,10 @@ const PlacedRun* placed(const std::vector<PlacedRun>& runs, const std::string& c
 
 // The placed solve, and the bound of the parts the kernels make up.
 void set_solve(AloneRun& out, const Roofs& roofs, const PlacedRun& run) {
-  out.waiting_s = run.waiting_s;
   for (const PhasePoint& p : run.phases) {
     if (p.work.phase != "solve") continue;
     out.solve_s = p.measured_s;
+    out.waiting_s = p.waiting_s;
     out.solve_bound_s = p.bound_s;
     for (const PhaseWork& part : p.work.parts)
       if (std::any_of(out.kernels.begin(), out.kernels.end(),

@@ -51,7 +51,7 @@ struct AloneRun {
   double solve_bound_s = 0.0;  // its bound
   double parts_bound_s = 0.0;  // the bound of the parts the kernels make up
   double alone_s = 0.0;        // the kernels alone: calls x seconds, summed
-  double waiting_s = 0.0;      // the step's waiting (the placement's, all phases)
+  double waiting_s = 0.0;      // the solve's waiting (in its bound)
 };
 
 // Each of `chapters` placed in `runs` on `scene`, at each thread count of `roofs`: a fresh

@@ -49,7 +49,7 @@ std::string kernels_alone_table(const std::vector<AloneRun>& runs) {
           << (k.bound_s > k.seconds ? "% (faster than its bound) | " : "% | ")
           << ms(k.calls * k.seconds) << " |\n";
   out << "\n| chapter | solve, ms | its bound | the kernels alone (their parts' bound) | in the "
-         "core | between the kernels | waiting (whole step) |\n| --- | ---: | ---: | ---: | ---: "
+         "core | between the kernels | the solve's waiting |\n| --- | ---: | ---: | ---: | ---: "
          "| ---: | ---: |\n";
   for (const AloneRun& r : runs)
     out << "| " << name(r) << " | " << ms(r.solve_s) << " | " << ms(r.solve_bound_s) << " | "

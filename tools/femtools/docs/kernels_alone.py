@@ -40,7 +40,7 @@ def section(data):
              f"{ms(1e3 * r['alone_s'])} ({ms(1e3 * r['parts_bound_s'])})", ms(1e3 * r["in_core_s"]),
              ms(1e3 * r["between_s"]), ms(1e3 * r["waiting_s"]), kernels_cell(r)] for r in runs]
     header = ["chapter", "solve, ms", "its bound, ms", "kernels alone, ms (their bound)",
-              "in the core, ms", "between the kernels, ms", "waiting (whole step), ms",
+              "in the core, ms", "between the kernels, ms", "the solve's waiting, ms",
               "each kernel alone: of its bound"]
     larger_part = "; ".join(f"{run_name(r)} {larger(r)}" for r in runs)
     return (table(header, rows, ["---"] + ["---:"] * 6 + ["---"]) +
