@@ -1,5 +1,5 @@
-// The chapter table of fem_bench: every chapter stepped on the same scene, one step of each in
-// turn, and its per-phase times and allocations summarized.
+// The chapter table of fem_bench: every chapter stepped on the same scene, in turns of a few
+// steps each, and its per-phase times and allocations summarized.
 #pragma once
 
 #include <array>
@@ -27,10 +27,10 @@ struct ChapterResult {
   int threads = 1;  // the thread count of the run: 1 for the single-threaded chapters
 };
 
-// Runs the chapters interleaved, one step of each in turn: when the machine's speed drifts
-// (a shared virtual machine, a CPU changing its clock), every chapter sees the same drift,
-// so their ratios hold even when the absolute times move. A chapter that uses threads (09 on)
-// runs once per thread count. Throws when a chapter's simulation diverges.
+// Runs the chapters interleaved, Schedule::turn steps of each in turn: when the machine's
+// speed drifts (a shared virtual machine, a CPU changing its clock), every chapter sees the
+// same drift, so their ratios hold even when the absolute times move. A chapter that uses threads
+// (09 on) runs once per thread count. Throws when a chapter's simulation diverges.
 std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& chapters,
                                         const Scene& scene, const SolverSettings& solver,
                                         const std::vector<int>& thread_counts,

@@ -41,8 +41,8 @@ int run_bench(const ArgParser& args) {
   const SourceState source = source_state();
   print_setup(scene, options, source);
   LoadMonitor load;
-  std::cout << "running " << options.chapters.size()
-            << " chapters interleaved, one step each in turn" << std::endl;
+  std::cout << "running " << options.chapters.size() << " chapters interleaved, " << Schedule::turn
+            << " steps of each in turn" << std::endl;
   const std::vector<ChapterResult> results = run_chapters(options.chapters, scene, options.solver,
                                                           options.thread_counts, options.schedule);
   print_chapters(results);

@@ -1,5 +1,9 @@
 // The steps of a benchmark: `warmup` unmeasured ones (the first allocates the steppers'
 // buffers), then `steps` measured ones, with a line of progress at every fifth of the run.
+// The chapters take turns of `turn` steps: within a turn a chapter steps as it does in an
+// interactive run, its data in the caches and its thread team awake; one step of each in
+// turn would measure, on a mesh whose data fit in the caches, the refill of the caches and
+// the waking of the team that the other chapters' steps cause, not the chapter's step.
 #pragma once
 
 #include <algorithm>
@@ -8,6 +12,7 @@ namespace fem::bench {
 
 struct Schedule {
   int warmup = 10, steps = 100;
+  static constexpr int turn = 10;
 
   int total() const { return warmup + steps; }
   bool measured(int k) const { return k >= warmup; }

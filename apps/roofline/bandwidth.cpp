@@ -11,31 +11,49 @@ namespace {
 
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kLanes = Eigen::internal::packet_traits<double>::size;
-// Independent partial sums: an addition's latency (about 4 cycles) times the two loads a core
-// issues per cycle. With one sum the loop would wait on its own additions and measure the
-// adder's latency, not the cache.
-constexpr int kSums = 8;
-constexpr std::size_t kStride = kSums * kLanes;
+// Packets per stride of the read and write loops (a kilobyte with AVX-512, half with AVX2):
+// the loop's own instructions few beside its loads. The read folds them into kPackets / 2
+// independent sums, more than a bitwise operation's latency (1 cycle) times the two loads a
+// core issues per cycle, so that the loop never waits on its own sums.
+constexpr int kPackets = kLanes >= 8 ? 16 : 8;
+constexpr std::size_t kStride = kPackets * kLanes;
 
 // Elements per thread for `bytes`, whole strides of the read kernel, at least one.
 std::size_t elements(std::size_t bytes) {
   return std::max<std::size_t>(1, bytes / sizeof(double) / kStride) * kStride;
 }
 
-// One pass of the read kernel: Eigen's packets (pload, padd, predux from
-// Eigen/src/Core/GenericPacketMath.h and the target's PacketMath.h), kSums sums in registers.
-double read_pass(const Eigen::VectorXd& a) {
+// Passes over the array per call of the read kernel: at least kCallBytes read, so that the
+// set-up and the final sum of a call (a hundred cycles or so) stay small beside an array in
+// L1, which one pass reads in a few hundred cycles.
+constexpr std::size_t kCallBytes = std::size_t(1) << 20;
+int passes(std::size_t n) {
+  return int(std::max<std::size_t>(1, kCallBytes / (n * sizeof(double))));
+}
+
+// The read kernel, `passes` passes over the array: Eigen's packets (pload, pxor, predux from
+// Eigen/src/Core/GenericPacketMath.h and the target's PacketMath.h), two loads folded into
+// one of kPackets / 2 sums by a bitwise operation (one vpternlogq where AVX-512 has it):
+// the loads then leave the vector ALUs half free, nearer a pure load (likwid-bench's
+// load_*), while the sums keep the compiler from dropping them. An addition per load, as in
+// Eigen's sum(), fills the two vector ALUs as the two loads fill the load ports, and the
+// roofline's own table shows that sum well under the read roof on an array in L1.
+double read_passes(const Eigen::VectorXd& a, int passes) {
   using namespace Eigen::internal;
+  constexpr int kSums = kPackets / 2;
   Packet sum[kSums];
   for (Packet& s : sum) s = pset1<Packet>(0.0);
   const double* data = a.data();
-  for (Eigen::Index i = 0; i < a.size(); i += kStride)
-    for (int k = 0; k < kSums; ++k) sum[k] = padd(sum[k], pload<Packet>(data + i + k * kLanes));
-  for (int k = 1; k < kSums; ++k) sum[0] = padd(sum[0], sum[k]);
+  for (int pass = 0; pass < passes; ++pass)
+    for (Eigen::Index i = 0; i < a.size(); i += kStride)
+      for (int k = 0; k < kSums; ++k)
+        sum[k] = pxor(sum[k], pxor(pload<Packet>(data + i + 2 * k * kLanes),
+                                   pload<Packet>(data + i + (2 * k + 1) * kLanes)));
+  for (int k = 1; k < kSums; ++k) sum[0] = pxor(sum[0], sum[k]);
   return predux(sum[0]);
 }
 
-// One pass of the write kernel: a packet store per packet of the array, kSums packets per
+// One pass of the write kernel: a packet store per packet of the array, kPackets packets per
 // stride as the read's (pstore, Eigen/src/Core/GenericPacketMath.h), of a value that changes
 // per pass so that no pass is dropped.
 double write_pass(Eigen::VectorXd& a) {
@@ -43,7 +61,7 @@ double write_pass(Eigen::VectorXd& a) {
   const Packet value = pset1<Packet>(a[0] + 1.0);
   double* data = a.data();
   for (Eigen::Index i = 0; i < a.size(); i += kStride)
-    for (int k = 0; k < kSums; ++k) pstore(data + i + k * kLanes, value);
+    for (int k = 0; k < kPackets; ++k) pstore(data + i + k * kLanes, value);
   return a[0];
 }
 
@@ -85,13 +103,14 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
 
 double read_bandwidth(std::size_t bytes, int threads, double seconds) {
   const std::size_t n = elements(bytes);
+  const int p = passes(n);
   return best_rate(
-      threads, seconds, double(n * sizeof(double)),
+      threads, seconds, double(p * n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [](const Eigen::VectorXd& a) { return read_pass(a); });
+      [p](const Eigen::VectorXd& a) { return read_passes(a, p); });
 }
 
-int read_sums() { return kSums; }
+int read_sums() { return kPackets / 2; }
 
 double write_bandwidth(std::size_t bytes, int threads, double seconds) {
   const std::size_t n = elements(bytes);

@@ -43,8 +43,8 @@ double read_bandwidth(std::size_t bytes, int threads, double seconds);
 // line is first read (write-allocate): the roof prices that read with the store.
 double write_bandwidth(std::size_t bytes, int threads, double seconds);
 
-// The independent packet sums of the read kernel (an addition's latency times the loads a
-// core issues per cycle), for the lesson's text.
+// The independent packet sums of the read kernel, two loads folded into one by a bitwise
+// operation, for the lesson's text.
 int read_sums();
 
 // The same read, by another kernel: Eigen's own sum (DenseBase::sum, Eigen/src/Core/Redux.h)

@@ -8,18 +8,23 @@
 
 namespace fem::roofline {
 
+constexpr int kRoofTimings = 5;
+
 // The best rate of a kernel run by `threads` threads at once, each on its own data made by
 // make() inside the team (so that the first touch places it by its thread). One timing is
 // the team's: from the barrier that starts every thread to the barrier after the last one
 // ends, `inner` calls per thread in between (doubled until a timing lasts long enough to
 // trust the clock); the rate is the units of all threads over that wall time, so that a
 // shared level (L3, memory) is credited only with what it sustains for all threads at once.
-// Repeated for about `seconds`, at least 3 and at most 50 timings; the best is the roof.
+// Timings of about a fifth of `seconds` each, repeated for about `seconds` (at least 3); the
+// best is the roof. likwid-bench's check (likwid.hpp) is timed the same way, the best of
+// kRoofTimings runs of a fifth of the time: a virtual machine's neighbours move a level's rate
+// between timings, and a shorter timing would catch a quieter moment than a longer one.
 // Returns units per second, with run(state) doing `units` units per call on one thread.
 template <class Make, class Run>
 double best_rate(int threads, double seconds, double units, Make make, Run run) {
   using Clock = std::chrono::steady_clock;
-  const double min_timing = std::max(2e-3, seconds / 40);
+  const double min_timing = std::max(2e-3, seconds / kRoofTimings);
   double best = 0.0, sink = 0.0, spent = 0.0;
   int inner = 1, timed = 0;
   bool stop = false;
@@ -47,7 +52,7 @@ double best_rate(int threads, double seconds, double units, Make make, Run run) 
         } else {
           best = std::max(best, units * threads * inner / t);
           ++timed;
-          stop = (spent > seconds && timed >= 3) || timed >= 50;
+          stop = (spent > seconds && timed >= 3) || timed >= 10 * kRoofTimings;
         }
       }  // single's barrier: every thread sees stop
       if (stop) break;

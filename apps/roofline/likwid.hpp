@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <string>
 
+#include "apps/roofline/best_rate.hpp"
+
 namespace fem::roofline {
 
 // What likwid-bench measured, or why it did not.
@@ -21,9 +23,17 @@ enum class LikwidKernel { load, store, peak };
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), running at least `seconds`.
+// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of
+// kRoofTimings runs of about a fifth of `seconds` each. A run's length is set by its
+// iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
+// -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
+// iterations, too short a time for any clock.
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds);
+                        double seconds, double expected);
+
+// The command line of one of likwid_bench's runs (its iterations from `expected`).
+std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
+                           double seconds, double expected);
 
 // The core's own limit at the clock measured on the spot: `per_cycle` loads (or multiply-
 // adds) of one packet each per cycle, times the packet's bytes (or its 2 flops per lane),

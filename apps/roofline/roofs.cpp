@@ -21,14 +21,18 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
     // Three arrays in the same working set as the read's one.
     roof.triad = triad_bandwidth(level.working_set / 3, threads, seconds);
     if (likwid) {
-      roof.likwid_read = likwid_bench(LikwidKernel::load, level.working_set, threads, seconds);
-      roof.likwid_write = likwid_bench(LikwidKernel::store, level.working_set, threads, seconds);
+      roof.likwid_read =
+          likwid_bench(LikwidKernel::load, level.working_set, threads, seconds, roof.read);
+      roof.likwid_write =
+          likwid_bench(LikwidKernel::store, level.working_set, threads, seconds, roof.write);
     }
     roofs.levels.push_back(roof);
   }
   roofs.peak_double = peak_flops_double(threads, seconds);
   roofs.peak_float = peak_flops_float(threads, seconds);
-  if (likwid) roofs.likwid_peak = likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds);
+  if (likwid)
+    roofs.likwid_peak =
+        likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds, roofs.peak_double);
   roofs.clock = measured_clock();
   roofs.barrier_s = barrier_seconds(threads);
   roofs.region_s = region_seconds(threads);
