@@ -2,6 +2,7 @@
 // series that ParaView opens).
 #include <array>
 #include <chrono>
+#include <csignal>
 #include <iostream>
 #include <optional>
 
@@ -16,6 +17,15 @@
 namespace {
 
 using namespace fem;
+
+// Ctrl-C (or a kill) stops the run after the step under way, not in the middle of a write:
+// the frames so far are kept and named (VtkSeries::keep_staged), the folder's lock released.
+volatile std::sig_atomic_t stop_requested = 0;
+extern "C" void request_stop(int) { stop_requested = 1; }
+
+struct Stopped {  // not a std::exception: main() answers it with 130, as a shell does SIGINT
+  int steps_done = 0;
+};
 
 struct Run {
   const ChapterInfo* chapter = nullptr;
@@ -33,7 +43,8 @@ void add_options(ArgParser& args) {
   args.option("watch", "NODE", "print this node's final position, 17 digits (-1: none)", "-1");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
-              "scene's name there is replaced once the run ends well, kept if it fails; a "
+              "scene's name there is replaced once the run ends well, kept if it fails or is "
+              "stopped (Ctrl-C: its frames so far in DIR/.SCENE.new); a "
               "folder another run is writing is refused)",
               "out/sim");
 }
@@ -80,6 +91,7 @@ void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& s
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
   for (int k = 1; k <= run.steps; ++k) {
+    if (stop_requested) throw Stopped{k - 1};
     const auto start = std::chrono::steady_clock::now();
     try {
       body.step();
@@ -148,8 +160,18 @@ void run_scene(const ArgParser& args, const Run& run) {
   std::optional<VtkSeries> series;
   if (run.every > 0) series.emplace(args.get("out"), args.get("scene"));
   const auto start = std::chrono::steady_clock::now();
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
   try {
     simulate(run, body, series);
+  } catch (const Stopped& stopped) {
+    std::cout << "fem_sim: stopped after step " << stopped.steps_done << " of " << run.steps;
+    if (series)
+      std::cout << "; an earlier series in " << args.get("out") << " is as it was, this run's "
+                << series->frames() << " frames are in " << series->keep_staged()
+                << " (the next run into " << args.get("out") << " removes them)";
+    std::cout << std::endl;
+    throw;
   } catch (const std::exception& e) {
     if (!series) throw;
     throw std::runtime_error(std::string(e.what()) + "\n(nothing of this run written to " +
@@ -183,6 +205,8 @@ int main(int argc, char** argv) {
   } catch (const fem::UsageError& e) {
     std::cerr << "fem_sim: " << e.what() << " (see fem_sim --help)\n";
     return 2;
+  } catch (const Stopped&) {
+    return 130;
   } catch (const std::exception& e) {
     std::cerr << "fem_sim: error: " << e.what() << "\n";
     return 1;

@@ -110,7 +110,12 @@ VtkSeries::VtkSeries(std::string directory, std::string name)
 
 VtkSeries::~VtkSeries() {
   std::error_code error;
-  if (!committed_) std::filesystem::remove_all(staging_, error);
+  if (!committed_ && !kept_) std::filesystem::remove_all(staging_, error);
+}
+
+std::string VtkSeries::keep_staged() {
+  kept_ = true;
+  return staging_path(name_ + ".pvd");
 }
 
 std::string VtkSeries::staging_path(const std::string& file) const {

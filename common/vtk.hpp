@@ -39,6 +39,11 @@ class VtkSeries {
   // in replaced_frames()). Renames need no space, so a full disk cannot stop it half-way.
   void commit();
 
+  // A run stopped on purpose (Ctrl-C) keeps what it wrote where it is, the earlier series
+  // untouched: the staging folder stays (the next run into the directory removes it). Returns
+  // the .pvd of the frames written so far.
+  std::string keep_staged();
+
   int frames() const { return static_cast<int>(times_.size()); }
   // The series' .pvd in the directory (it names the new frames once commit() has run).
   std::string pvd_path() const;
@@ -50,7 +55,7 @@ class VtkSeries {
   std::string directory_, name_, staging_;
   std::vector<double> times_;
   int replaced_frames_ = 0;
-  bool committed_ = false;
+  bool committed_ = false, kept_ = false;
 };
 
 }  // namespace fem

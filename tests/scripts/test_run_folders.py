@@ -4,13 +4,15 @@
 fem_bench and fem_sim into a folder another run is writing are refused before any work,
 naming it; --replace replaces a finished run only and says so only then; a write that fails
 (FEM_FAIL_WRITES, a full disk injected) exits non-zero with the path and the cause and
-leaves the folder byte-identical; fem_viewer checks its output files before the work; a run of more than a minute says how long before it goes on,
+leaves the folder byte-identical; Ctrl-C keeps the frames so far and names them; fem_viewer checks its output files before the work; a run of more than a minute says how long before it goes on,
 and its lines reach a file. Prints 'N passed, M failed' last.
 
     test_run_folders.py --bench build/release/fem_bench --sim build/release/fem_sim"""
 import argparse
 import os
 import pathlib
+import re
+import signal
 import subprocess
 import sys
 import tempfile
@@ -117,6 +119,31 @@ def sim_cases(sim, tmp):
               p.stdout + p.stderr)
         check(f"fem_sim: ... and leaves the earlier series byte-identical, no temporary file",
               snapshot(folder) == before, sorted(snapshot(folder)))
+    interrupted_case(base, folder, before, tmp)
+
+
+def interrupted_case(base, folder, before, tmp):
+    """Ctrl-C part-way: the run stops after its step, exit 130, says where its frames are; the
+    earlier series is byte-identical, the frames so far are a valid series in the staging
+    folder, the lock is released (a next run goes ahead and removes them)."""
+    with open(tmp / "interrupted.log", "w") as log:
+        p = holder(base + ["--steps", "1000000", "--every", "1", "--out", folder], log)
+        started = wait_for(folder / ".cantilever.new" / "cantilever_000003.vtu", seconds=120)
+        p.send_signal(signal.SIGINT)
+        code = p.wait(timeout=120)
+    text = (tmp / "interrupted.log").read_text()
+    staged = folder / ".cantilever.new" / "cantilever.pvd"
+    check("fem_sim: Ctrl-C stops after the step under way, exit 130, naming its frames",
+          started and code == 130 and "stopped after step" in text and str(staged) in text, text)
+    listed = re.findall(r'file="([^"]+)"', staged.read_text()) if staged.exists() else []
+    check("fem_sim: ... its frames so far a whole series in the staging folder",
+          len(listed) >= 4 and all((staged.parent / f).exists() for f in listed), listed[:5])
+    check("fem_sim: ... the earlier series byte-identical, the lock released",
+          {k: v for k, v in snapshot(folder).items() if k != ".cantilever.new"} == before,
+          sorted(snapshot(folder)))
+    p = run(*base, "--steps", "2", "--out", folder)
+    check("fem_sim: ... and the next run goes ahead and removes them",
+          p.returncode == 0 and not staged.parent.exists(), p.stdout + p.stderr)
 
 
 def long_run_case(bench, tmp):
