@@ -12,10 +12,36 @@ import hashlib
 import json
 import pathlib
 import re
+import shutil
+import subprocess
 import sys
 import tempfile
 
-from test_variant_build import check, copy_repo, results, run
+from test_exercises import ROOT, check, results
+
+
+def run(*args, cwd=None):
+    return subprocess.run([str(a) for a in args], capture_output=True, text=True, cwd=cwd)
+
+
+def copy_repo(tmp, venv):
+    def ignore(directory, names):
+        return {n for n in names if n in ("__pycache__", "build", ".venv")
+                or (pathlib.Path(directory) / n / "variant_of").exists()}
+    repo = tmp / "repo"
+    for part in ("chapters", "common", "femcourse", "cmake", "apps", "tests", "tools"):
+        shutil.copytree(ROOT / part, repo / part, ignore=ignore)
+    (repo / "meshes").mkdir()
+    for mesh in ("test_beam.msh", "plate_poster.msh"):
+        shutil.copy(ROOT / "meshes" / mesh, repo / "meshes" / mesh)
+    for name in ("CMakeLists.txt", "CMakePresets.json"):
+        shutil.copy(ROOT / name, repo / name)
+    # The venv linked, not named by its path: the copy's command lines then name it as the
+    # original's do (relative to the build folder, CMakeLists.txt's CCACHE_BASEDIR), and
+    # ccache serves every file the new chapter leaves unchanged from the original's build.
+    (repo / ".venv").symlink_to(pathlib.Path(venv).resolve())
+    return repo
+
 
 PHASES = ("forces", "dfdx", "compose", "constraints", "solve")
 
