@@ -12,9 +12,7 @@ namespace {
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kLanes = Eigen::internal::packet_traits<double>::size;
 // Packets per stride of the read and write loops (a kilobyte with AVX-512, half with AVX2):
-// the loop's own instructions few beside its loads. The read folds them into kPackets / 2
-// independent sums, more than a bitwise operation's latency (1 cycle) times the two loads a
-// core issues per cycle, so that the loop never waits on its own sums.
+// the loop's own instructions few beside its loads.
 constexpr int kPackets = kLanes >= 8 ? 16 : 8;
 constexpr std::size_t kStride = kPackets * kLanes;
 
@@ -31,26 +29,33 @@ int passes(std::size_t n) {
   return int(std::max<std::size_t>(1, kCallBytes / (n * sizeof(double))));
 }
 
-// The read kernel, `passes` passes over the array: Eigen's packets (pload, pxor, predux from
-// Eigen/src/Core/GenericPacketMath.h and the target's PacketMath.h), two loads folded into
-// one of kPackets / 2 sums by a bitwise operation (one vpternlogq where AVX-512 has it):
-// the loads then leave the vector ALUs half free, nearer a pure load (likwid-bench's
-// load_*), while the sums keep the compiler from dropping them. An addition per load, as in
-// Eigen's sum(), fills the two vector ALUs as the two loads fill the load ports, and the
-// roofline's own table shows that sum well under the read roof on an array in L1.
+// Keeps a loaded packet without an instruction: an empty asm statement that takes it in a
+// vector register ("v" on x86: any xmm/ymm/zmm, "w" on AArch64), so the compiler must load it
+// and need not compute anything from it. Any arithmetic on the loads costs the loop issue slots
+// beside its loads, which an array in L1 delivers two a cycle: Eigen's sum(), an addition per
+// load, runs well under the read roof there (the roofline's own table), and even one bitwise
+// operation per two loads stayed 15-18% under likwid-bench's load kernel on an AVX-512 Xeon.
+inline void keep(const Packet& packet) {
+#if defined(__x86_64__) || defined(__i386__)
+  asm volatile("" ::"v"(packet));
+#elif defined(__aarch64__)
+  asm volatile("" ::"w"(packet));
+#else
+  asm volatile("" ::"g"(packet));
+#endif
+}
+
+// The read kernel, `passes` passes over the array: Eigen's packet loads (pload,
+// Eigen/src/Core/GenericPacketMath.h and the target's PacketMath.h) and nothing else, as
+// likwid-bench's load_* kernels, the loop's own increment and branch aside.
 double read_passes(const Eigen::VectorXd& a, int passes) {
   using namespace Eigen::internal;
-  constexpr int kSums = kPackets / 2;
-  Packet sum[kSums];
-  for (Packet& s : sum) s = pset1<Packet>(0.0);
   const double* data = a.data();
+  const Eigen::Index n = a.size();
   for (int pass = 0; pass < passes; ++pass)
-    for (Eigen::Index i = 0; i < a.size(); i += kStride)
-      for (int k = 0; k < kSums; ++k)
-        sum[k] = pxor(sum[k], pxor(pload<Packet>(data + i + 2 * k * kLanes),
-                                   pload<Packet>(data + i + (2 * k + 1) * kLanes)));
-  for (int k = 1; k < kSums; ++k) sum[0] = pxor(sum[0], sum[k]);
-  return predux(sum[0]);
+    for (Eigen::Index i = 0; i < n; i += kStride)
+      for (int k = 0; k < kPackets; ++k) keep(pload<Packet>(data + i + k * kLanes));
+  return data[0];
 }
 
 // One pass of the write kernel: a packet store per packet of the array, kPackets packets per
@@ -110,7 +115,7 @@ double read_bandwidth(std::size_t bytes, int threads, double seconds) {
       [p](const Eigen::VectorXd& a) { return read_passes(a, p); });
 }
 
-int read_sums() { return kPackets / 2; }
+int read_packets() { return kPackets; }
 
 double write_bandwidth(std::size_t bytes, int threads, double seconds) {
   const std::size_t n = elements(bytes);

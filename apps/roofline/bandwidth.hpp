@@ -33,7 +33,7 @@ struct MemoryLevel {
 // times the largest cache.
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads);
 
-// The best read bandwidth (bytes/s) of `threads` threads, each summing its own array of
+// The best read bandwidth (bytes/s) of `threads` threads, each loading its own array of
 // `bytes` over and over for about `seconds`: the best of several timed repetitions, since a
 // roof is what the machine can do, and a slower repetition only says something else ran.
 double read_bandwidth(std::size_t bytes, int threads, double seconds);
@@ -43,9 +43,9 @@ double read_bandwidth(std::size_t bytes, int threads, double seconds);
 // line is first read (write-allocate): the roof prices that read with the store.
 double write_bandwidth(std::size_t bytes, int threads, double seconds);
 
-// The independent packet sums of the read kernel, two loads folded into one by a bitwise
-// operation, for the lesson's text.
-int read_sums();
+// The packets the read kernel loads per stride, each kept by an empty asm statement and not
+// summed, for the lesson's text.
+int read_packets();
 
 // The same read, by another kernel: Eigen's own sum (DenseBase::sum, Eigen/src/Core/Redux.h)
 // of a VectorXd per thread. The roof's second, independent measurement.

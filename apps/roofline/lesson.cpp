@@ -47,7 +47,8 @@ std::vector<Roofs> machine_roofs(const LessonRun& run) {
 std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
   std::ostringstream out;
   out << "\nRoofs: the best of repeated timings of each kernel, every thread on its own array "
-      << "(read: " << read_sums() << " independent packet sums, two loads to a bitwise operation; "
+      << "(read: packet loads, " << read_packets()
+      << " a stride, each kept by an empty asm statement and not summed, as likwid-bench's; "
       << "write: packet stores; "
       << "peak: " << fma_chains() << " independent chains of Eigen packet multiply-adds, "
       << double_lanes() << " doubles or " << float_lanes()
