@@ -443,8 +443,9 @@ docs() {
   log "figures of chapters 10-12 (fem-tools plots figures, from docs/data/figures/ and the code)"
   fem_tools plots figures --out docs/images
   fem_tools docs update
-  log "chapter diffs (docs/diffs/)"
+  log "chapter diffs (docs/diffs/) and the phase-owners table (fem_lessons phase-owners)"
   fem_tools docs diffs
+  "$BUILD_DIR/fem_lessons" phase-owners --write chapters/README.md
   log "the cantilever's animation (docs/images/cantilever.gif, from ./tutorial.sh sim's run)"
   sim --out out/docs_sim >/dev/null
   cp out/docs_sim/cantilever.gif docs/images/cantilever.gif

@@ -49,7 +49,7 @@ std::vector<int> aggregates(const ch10::Level<B>& level) {
 // size and the smoothing steps of its V-cycle, per node of a non-coarsest level its aggregate.
 void hierarchy(std::ostream& out, const Scene& scene) {
   const ch10::MultigridStepper stepper(scene, SolverSettings{});
-  const ch10::Multigrid& mg = stepper.multigrid();
+  const ch10::Multigrid& mg = stepper.preconditioner().multigrid();
   const ch10::SmootherSettings& relax = mg.settings().relax;
   const bool chebyshev = relax.smoother == ch10::Smoother::Chebyshev;
   out << "  \"smoother\": \"" << (chebyshev ? "Chebyshev" : "other") << "\",\n"

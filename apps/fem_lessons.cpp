@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/phase_owners.hpp"
 #include "apps/roofline/lesson.hpp"
 #include "chapters/registry.hpp"
 #include "common/atomic_file.hpp"
@@ -49,7 +50,9 @@ std::string usage() {
            ": " + f.lesson.summary + "\n";
   return out + "without a lesson: every lesson in turn, with its defaults\n" +
          "record-all [--out DIR]: every lesson with the arguments it is recorded with, as " +
-         "DIR/LESSON.json\n";
+         "DIR/LESSON.json\n" +
+         "phase-owners [--write FILE | --check FILE]: which part of which chapter runs each " +
+         "phase of each chapter's step, from the recipes (chapters/README.md's table)\n";
 }
 
 // The lesson `name` of chapter `id` (a variant has its own copy); throws UsageError.
@@ -229,6 +232,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (first == "record-all") return record_all(lessons, argc - 1, argv + 1);
+  if (first == "phase-owners") return phase_owners_command(argc - 1, argv + 1);
   const auto it = std::find_if(lessons.begin(), lessons.end(),
                                [&](const Found& f) { return f.lesson.name == first; });
   if (it == lessons.end()) {

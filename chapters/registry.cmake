@@ -89,13 +89,18 @@ foreach(header ${headers})
     fem_fail(${dir} "stepper.hpp has no `namespace fem::<name> {`")
   endif()
   set(ns ${CMAKE_MATCH_1})
+  # The chapter's stepper: a class `class <Name> [final] : public ...Stepper` (chapters 01-07) or
+  # a recipe's step `using <Name> = [ch08::]StepOf<Recipe>;` (chapter 08 on).
   string(REGEX MATCHALL "class[ \t\r\n]+[A-Za-z_][A-Za-z0-9_]*[ \t\r\n]+(final[ \t\r\n]+)?:[ \t\r\n]*public[ \t\r\n]+(fem::)?([A-Za-z_][A-Za-z0-9_]*::)?[A-Za-z0-9_]*Stepper[^A-Za-z0-9_]"
          steppers "${text}")
+  string(REGEX MATCHALL "using[ \t\r\n]+[A-Za-z_][A-Za-z0-9_]*[ \t\r\n]*=[ \t\r\n]*([A-Za-z_][A-Za-z0-9_]*::)?StepOf<"
+         recipes "${text}")
+  list(APPEND steppers ${recipes})
   list(LENGTH steppers count)
   if(NOT count EQUAL 1)
-    fem_fail(${dir} "stepper.hpp declares ${count} classes `class <Name> [final] : public Stepper`, not one")
+    fem_fail(${dir} "stepper.hpp declares ${count} steppers (`class <Name> [final] : public Stepper` or `using <Name> = StepOf<Recipe>;`), not one")
   endif()
-  string(REGEX REPLACE "^class[ \t\r\n]+([A-Za-z0-9_]+).*" "\\1" class "${steppers}")
+  string(REGEX REPLACE "^(class|using)[ \t\r\n]+([A-Za-z0-9_]+).*" "\\2" class "${steppers}")
   file(STRINGS ${SOURCE_DIR}/chapters/${dir}/README.md heading LIMIT_COUNT 1)
   if(NOT heading MATCHES "^# Chapter [^:]+: (.+)$")
     fem_fail(${dir} "README.md does not start with `# Chapter NN: <title>`")
@@ -147,7 +152,8 @@ ChapterInfo chapter(std::string id, std::string title, std::string variant_of,
           [](const Scene& scene, const SolverSettings& s) {
             return std::unique_ptr<Stepper>(std::make_unique<ChapterStepper>(scene, s));
           },
-          std::move(variant_of), lessons, std::move(source_hash), work_of<ChapterStepper>()};
+          std::move(variant_of), lessons, std::move(source_hash), work_of<ChapterStepper>(),
+          owners_of<ChapterStepper>()};
 }
 
 }  // namespace

@@ -11,9 +11,13 @@ const std::vector<ChapterInfo>& chapters() {
     std::vector<ChapterInfo> found = detail::in_course_order(detail::discovered_chapters());
     // A single-threaded chapter (01-08) steps on one thread in every program: see
     // on_one_thread (common/stepper.hpp) and why it matters (common/threads.hpp).
+    // Each stepper is named by its registry id, the one id it warns under.
     for (ChapterInfo& c : found)
-      c.make = [make = std::move(c.make)](const Scene& scene, const SolverSettings& settings) {
-        return on_one_thread(make(scene, settings), scene);
+      c.make = [make = std::move(c.make), id = c.id](const Scene& scene,
+                                                     const SolverSettings& settings) {
+        auto stepper = on_one_thread(make(scene, settings), scene);
+        stepper->set_name(id);
+        return stepper;
       };
     return found;
   }();

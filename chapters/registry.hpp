@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "chapters/work.hpp"
@@ -13,6 +14,14 @@
 #include "common/stepper.hpp"
 
 namespace fem {
+
+// A part of a chapter's step that runs in one of its phases (chapter 08 on: from the recipe).
+struct PhaseOwner {
+  std::string phase;    // a StepProfile phase: "forces", "compose", "constraints", "solve"
+  std::string role;     // the part's role in the recipe: "elements", "solver", ...
+  std::string name;     // the part's own name
+  std::string chapter;  // the chapter folder that teaches it
+};
 
 struct ChapterInfo {
   std::string id;     // directory name, e.g. "01_naive"
@@ -28,7 +37,25 @@ struct ChapterInfo {
   // stepper its `make` returns: its work.hpp's count_work, or that of the chapter it extends
   // (found by argument-dependent lookup on its stepper's class); empty if none counts.
   ChapterWork work;
+  // Which parts run each phase, from the stepper's recipe; empty for a stepper that is one
+  // class (chapters 01-07: its step() runs every phase).
+  std::vector<PhaseOwner> owners;
 };
+
+// The owners of S's phases, where S is a step of parts (it has phase_owners()).
+template <class S, class = void>
+struct HasPhaseOwners : std::false_type {};
+template <class S>
+struct HasPhaseOwners<S, std::void_t<decltype(S::phase_owners())>> : std::true_type {};
+
+template <class S>
+std::vector<PhaseOwner> owners_of() {
+  std::vector<PhaseOwner> owners;
+  if constexpr (HasPhaseOwners<S>::value)
+    for (const auto& [phase, part] : S::phase_owners())
+      owners.push_back({phase, part.role, part.name, std::string(part.chapter)});
+  return owners;
+}
 
 // Every chapter present, in order; each variant right after the chapter it came from. The
 // steppers their `make` returns run on one thread unless they uses_threads() (on_one_thread).

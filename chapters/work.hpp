@@ -19,6 +19,7 @@
 //    would price the fine level's kernels, whose data fit an inner cache, at an outer one.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -91,15 +92,30 @@ struct WorkCounts {
   ExecutedWork per_step;
 };
 
-// The hook of ChapterInfo: both null for a chapter that counts nothing.
+// A kernel of one of a stepper's parts, timed alone by the roofline (the kernels-alone table):
+// the part's own code on the part's own data, as the step runs it.
+struct PartKernel {
+  std::string name;           // e.g. "product q = A p"
+  std::string part;           // the solve's part (PhaseWork::parts) it is, or with others makes up
+  PhaseWork work;             // one call
+  double calls = 0.0;         // per step
+  std::function<void()> run;  // one call, by every thread of a team (or by one thread)
+};
+
+// The hook of ChapterInfo: null for a chapter that counts nothing.
 struct ChapterWork {
   std::vector<PhaseWork> (*count)(const Stepper&, const Scene&, const WorkCounts&) = nullptr;
   ExecutedWork (*executed)(const Stepper&) = nullptr;
+  // The solve's kernels of the stepper's parts at `iterations` PCG iterations a step; they
+  // run on the stepper's own data, so the stepper is the caller's, stepped a few times.
+  std::vector<PartKernel> (*kernels)(Stepper&, const Scene&, double iterations) = nullptr;
 };
 
-// The hook of a chapter whose stepper is S: count_work (and executed_work, if any) for S's
-// class or the class it derives from nearest, found by argument-dependent lookup in those
-// classes' namespaces. The registry fills ChapterInfo::work with it.
+// The hook of a chapter whose stepper is S: count_work (and executed_work, if any) for S,
+// found by argument-dependent lookup (a chapter 01-07 stepper's own; from chapter 08 on the
+// sum of the recipe's parts' counts, chapters/08_element_kernels/work.hpp). The registry fills
+// ChapterInfo::work with it, for the steppers its `make` returns: those are S (inside
+// on_one_thread's wrapper, which unwrapped removes), so the casts below cannot fail.
 template <class S, class = void>
 struct CountsWork : std::false_type {};
 template <class S>
@@ -112,16 +128,27 @@ template <class S>
 struct CountsExecuted<S, std::void_t<decltype(executed_work(std::declval<const S&>()))>>
     : std::true_type {};
 
+template <class S, class = void>
+struct HasKernels : std::false_type {};
+template <class S>
+struct HasKernels<
+    S, std::void_t<decltype(solve_kernels(std::declval<S&>(), std::declval<const Scene&>(), 1.0))>>
+    : std::true_type {};
+
 template <class S>
 ChapterWork work_of() {
   ChapterWork work;
   if constexpr (CountsWork<S>::value)
     work.count = [](const Stepper& s, const Scene& scene, const WorkCounts& counts) {
-      return count_work(dynamic_cast<const S&>(unwrapped(s)), scene, counts);
+      return count_work(static_cast<const S&>(unwrapped(s)), scene, counts);
     };
   if constexpr (CountsExecuted<S>::value)
     work.executed = [](const Stepper& s) {
-      return executed_work(dynamic_cast<const S&>(unwrapped(s)));
+      return executed_work(static_cast<const S&>(unwrapped(s)));
+    };
+  if constexpr (HasKernels<S>::value)
+    work.kernels = [](Stepper& s, const Scene& scene, double iterations) {
+      return solve_kernels(static_cast<S&>(unwrapped(s)), scene, iterations);
     };
   return work;
 }

@@ -49,6 +49,11 @@ class OneThreadStepper final : public Stepper {
   void set_external_forces(const std::vector<ExternalForce>& forces) override {
     inner_->set_external_forces(forces);
   }
+  void describe(std::ostream& out) const override { inner_->describe(out); }
+  void set_name(const std::string& name) override {
+    Stepper::set_name(name);
+    inner_->set_name(name);
+  }
   const Eigen::SparseVector<double>& external_forces() const override {
     return inner_->external_forces();
   }
@@ -70,11 +75,22 @@ const Stepper& unwrapped(const Stepper& stepper) {
   return wrapper ? wrapper->inner() : stepper;
 }
 
+Stepper& unwrapped(Stepper& stepper) {
+  // The wrapper holds the stepper it was given, which is not const: the cast only undoes the
+  // const of the const overload's answer.
+  return const_cast<Stepper&>(unwrapped(static_cast<const Stepper&>(stepper)));
+}
+
+void Stepper::describe(std::ostream& out) const {
+  // A chapter before 08 is one class: its step is its only part.
+  out << "one stepper class: every phase in its own step()\n";
+}
+
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
                              const char* chapter, bool& already_warned) {
   if (profile.converged || already_warned) return;
   already_warned = true;
-  std::cerr << "warning: " << chapter << ": ";
+  std::cerr << "warning: " << (*chapter ? chapter : "stepper") << ": ";
   if (std::isfinite(profile.relative_residual))
     std::cerr << "the linear solve stopped at the iteration cap (" << settings.max_iterations
               << ") with relative residual " << profile.relative_residual << " > tolerance "

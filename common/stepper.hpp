@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -109,13 +110,30 @@ class Stepper {
   virtual void set_external_forces(const std::vector<ExternalForce>& forces);
   virtual const Eigen::SparseVector<double>& external_forces() const { return f_ext_; }
 
+  // What the stepper built, for a reader: its parts and what they hold (a stepper made of
+  // parts, chapter 08 on, prints its recipe and its multigrid's levels); `out << stepper`.
+  virtual void describe(std::ostream& out) const;
+
+  // The chapter's id the registry made this stepper for ("" when made directly): the
+  // stepper's warnings name it. (Virtual so that on_one_thread's wrapper can pass it on.)
+  virtual void set_name(const std::string& name) { name_ = name; }
+  const std::string& name() const { return name_; }
+
  protected:
   explicit Stepper(const Scene& scene);
 
   // The poster's `sparse_vec`: a few nonzeros among 3N, kept sparse so that adding it to
   // a dense vector touches only those entries.
   Eigen::SparseVector<double> f_ext_;
+
+ private:
+  std::string name_;
 };
+
+inline std::ostream& operator<<(std::ostream& out, const Stepper& stepper) {
+  stepper.describe(out);
+  return out;
+}
 
 // The stepper itself when it uses_threads(); otherwise a stepper that runs each of its steps
 // inside a OneThreadScope (OpenMP's and Eigen's thread counts at 1, restored after), so that
@@ -125,6 +143,7 @@ std::unique_ptr<Stepper> on_one_thread(std::unique_ptr<Stepper> stepper, const S
 // The chapter's own stepper inside on_one_thread's wrapper (itself when not wrapped): the
 // roofline lesson reads the data structures it holds.
 const Stepper& unwrapped(const Stepper& stepper);
+Stepper& unwrapped(Stepper& stepper);
 
 // Measures one phase into a StepProfile field: `PhaseTimer t(profile_.solve);`. Made and
 // ended outside the parallel regions (on the thread that steps), so the synchronizations

@@ -200,7 +200,7 @@ struct ThreadedSolvers {
       : stepper(s),
         settings(set),
         pcg(s.system_matrix(), scene.constraints),
-        block_jacobi(s.diagonal_blocks()) {
+        block_jacobi(s.system().index.diagonal) {
     cg.setTolerance(settings.tolerance);
     cg.setMaxIterations(settings.max_iterations);
   }

@@ -35,7 +35,10 @@ struct KernelAlone {
 // each with its work per call and its calls per step at `iterations` CG iterations per
 // solve. Empty for a stepper of an earlier chapter. The stepper must have taken a step; the
 // kernels write its work vectors.
-std::vector<KernelAlone> solve_kernels(Stepper& stepper, const Scene& scene, double iterations);
+// The solve's kernels of `stepper`, which `chapter` made and which ran a few steps, at
+// `iterations` PCG iterations a step: its parts' own (ChapterInfo::work.kernels).
+std::vector<KernelAlone> solve_kernels(const ChapterInfo& chapter, Stepper& stepper,
+                                       const Scene& scene, double iterations);
 
 // Seconds of one call of `kernel` on `threads` threads: the best of repeated timings, each of
 // enough calls in one parallel region to trust the clock. Each call ends at its loop's barrier,

@@ -122,7 +122,7 @@ void NaiveStepper::solve() {
   profile_.cg_iterations = static_cast<int>(cg_.iterations());
   profile_.relative_residual = cg_.error();
   profile_.converged = cg_.info() == Eigen::Success;
-  report_if_not_converged(profile_, settings_, "01_naive", warned_not_converged_);
+  report_if_not_converged(profile_, settings_, name().c_str(), warned_not_converged_);
 }
 
 }  // namespace fem::ch01

@@ -60,12 +60,18 @@ double matrix_bytes(const Eigen::SparseMatrix<double>& m) {
 
 PhaseWork pcg_work(const MeshSizes& m, double iterations, double matrix, double matrix_flops,
                    const PhaseWork& preconditioner) {
-  const double passes = iterations + 1.0;
   const double v = m.vector_bytes;
   // The PCG's own kernels: the product (the matrix and p read, q written fresh) and the
   // updates (two vectors read each, x, r and p written back).
-  PhaseWork own = phase_work("pcg", matrix + v + 3 * 2 * v, v + 3 * v, v,
-                             matrix_flops + 10 * m.dofs, matrix + 5 * v);
+  const PhaseWork own = phase_work("pcg", matrix + v + 3 * 2 * v, v + 3 * v, v,
+                                   matrix_flops + 10 * m.dofs, matrix + 5 * v);
+  return pcg_work(m, iterations, own, preconditioner);
+}
+
+PhaseWork pcg_work(const MeshSizes& m, double iterations, const PhaseWork& own,
+                   const PhaseWork& preconditioner) {
+  const double passes = iterations + 1.0;
+  const double v = m.vector_bytes;
   // The preconditioner reads r and writes z (fresh lines) besides its own data; a
   // preconditioner made of kernels (a V-cycle) keeps them, each at its own level.
   PhaseWork apply = phase_work("preconditioner", v, v, v, 0.0, 2 * v);
@@ -78,7 +84,7 @@ PhaseWork pcg_work(const MeshSizes& m, double iterations, double matrix, double 
     apply.working_set += preconditioner.working_set;
   }
   PhaseWork w =
-      phase_work("solve", 0.0, 0.0, 0.0, 0.0, matrix + preconditioner.working_set + 5 * v);
+      phase_work("solve", 0.0, 0.0, 0.0, 0.0, own.working_set + preconditioner.working_set);
   w.add_part(own, passes);
   w.add_part(apply, passes);
   if (!preconditioner.parts.empty()) w.add_part(preconditioner, passes);

@@ -37,6 +37,9 @@ double matrix_bytes(const Eigen::SparseMatrix<double>& m);
 // made of parts, each of them).
 PhaseWork pcg_work(const MeshSizes& m, double iterations, double matrix, double matrix_flops,
                    const PhaseWork& preconditioner);
+// The same with the PCG's own kernels counted by the caller (another form of the iteration).
+PhaseWork pcg_work(const MeshSizes& m, double iterations, const PhaseWork& own,
+                   const PhaseWork& preconditioner);
 
 // The steppers on Eigen's compressed matrices: df/dx and A from common/'s element loop, the
 // constraints as sparse products S A S^T into a second matrix (`in_place` false) or on the

@@ -139,7 +139,7 @@ void NoAliasStepper::solve() {
   profile_.cg_iterations = static_cast<int>(cg_.iterations());
   profile_.relative_residual = cg_.error();
   profile_.converged = cg_.info() == Eigen::Success;
-  report_if_not_converged(profile_, settings_, "02_noalias", warned_not_converged_);
+  report_if_not_converged(profile_, settings_, name().c_str(), warned_not_converged_);
 }
 
 }  // namespace fem::ch02

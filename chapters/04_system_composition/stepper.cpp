@@ -199,7 +199,7 @@ void SystemCompositionStepper::solve() {
   profile_.cg_iterations = static_cast<int>(cg_.iterations());
   profile_.relative_residual = cg_.error();
   profile_.converged = cg_.info() == Eigen::Success;
-  report_if_not_converged(profile_, settings_, "04_system_composition", warned_not_converged_);
+  report_if_not_converged(profile_, settings_, name().c_str(), warned_not_converged_);
 }
 
 }  // namespace fem::ch04

@@ -227,7 +227,7 @@ void CustomPcgStepper::solve() {
   dv_ = y_;
   dv_ += z_;
   profile_.record(result);
-  report_if_not_converged(profile_, settings_, "06_custom_pcg", warned_not_converged_);
+  report_if_not_converged(profile_, settings_, name().c_str(), warned_not_converged_);
 }
 
 std::vector<int> diagonal_offsets(const Eigen::SparseMatrix<double>& A) {

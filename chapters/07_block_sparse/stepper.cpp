@@ -84,7 +84,7 @@ void BlockSparseStepper::solve() {
   dv_ = y_;
   dv_ += z_;
   profile_.record(result);
-  report_if_not_converged(profile_, settings_, "07_block_sparse", warned_not_converged_);
+  report_if_not_converged(profile_, settings_, name().c_str(), warned_not_converged_);
 }
 
 }  // namespace fem::ch07

@@ -43,9 +43,9 @@ ElementSample sample_step(const Scene& scene) {
   for (int k = 0; k < 20; ++k) stepper.step(state);
   ElementSample sample{Model(scene),
                        {},
-                       stepper.elements().rotations(),
-                       stepper.elements().previous_rotations(),
-                       stepper.elements().shapes()};
+                       stepper.elements().fused().rotations(),
+                       stepper.elements().fused().previous_rotations(),
+                       stepper.elements().fused().shapes()};
   for (std::size_t e = 0; e < sample.model.tets.size(); ++e)
     sample.F.push_back(
         deformation_gradient(sample.model.rest[e], gather(state.x, sample.model.tets[e])));
@@ -178,8 +178,9 @@ std::string fallback_counts(const Scene& bench_scene, int steps) {
     ElementKernelsStepper run(scene, {});
     State s = rest_state(scene);
     for (int k = 0; k < steps; ++k) run.step(s);
-    scenes << (scenes.tellp() > 0 ? ", " : "") << name << " " << run.elements().total_fallbacks()
-           << " of " << static_cast<long long>(steps) * bench_scene.mesh.num_tets();
+    scenes << (scenes.tellp() > 0 ? ", " : "") << name << " "
+           << run.elements().fused().total_fallbacks() << " of "
+           << static_cast<long long>(steps) * bench_scene.mesh.num_tets();
   }
   return scenes.str();
 }

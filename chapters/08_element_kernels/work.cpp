@@ -13,13 +13,9 @@ constexpr double kQuaternionProductFlops = 28.0;  // 16 multiplies, 12 adds
 
 }  // namespace
 
-std::vector<PhaseWork> fused_work(const ElementKernelsStepper& stepper, const Scene& scene,
-                                  const WorkCounts& counts, const PhaseWork& preconditioner,
-                                  double prepare_read, double prepare_written) {
-  const ch01::MeshSizes m = ch01::mesh_sizes(scene);
-  const ch07::BlockSparseMatrix& A = stepper.system_matrix();
-  const double blocks = double(A.blocks.size()) * kBlock, v = m.vector_bytes;
-  const double matrix = ch07::matrix_bytes(A), entries = 9.0 * double(A.blocks.size());
+ElementWork fused_pass_work(const WorkInput& in) {
+  const ch01::MeshSizes& m = in.m;
+  const double blocks = double(in.A.blocks.size()) * kBlock, v = m.vector_bytes;
   // compose: every block of A zeroed (fresh lines), the mass on the diagonal (the diagonal
   // index read); b from gravity, M, v and f_ext.
   const PhaseWork compose =
@@ -30,30 +26,56 @@ std::vector<PhaseWork> fused_work(const ElementKernelsStepper& stepper, const Sc
   const double per_element = sizeof(ElementShape) + 2 * sizeof(Eigen::Quaterniond) +
                              sizeof(Eigen::Vector4i) + sizeof(std::array<int, 16>);
   const double rotations = m.elements * 2 * sizeof(Eigen::Quaterniond);
-  const PhaseWork forces =
-      ch01::phase_work("forces", m.elements * per_element + blocks + 3 * v, rotations + blocks + v,
-                       0.0, m.elements * fused_element_flops() + rotation_flops(counts, m.elements),
-                       m.elements * per_element + blocks + 3 * v);
-  PhaseWork solve = ch01::pcg_work(m, counts.cg_iterations, matrix, 2 * entries, preconditioner);
-  solve.add_part(ch01::phase_work("prepare", prepare_read, prepare_written, prepare_written, 0.0,
-                                  prepare_read + prepare_written),
-                 1.0);
-  return {forces, compose, ch07::block_constraints(m, A, scene), solve};
+  const PhaseWork forces = ch01::phase_work(
+      "forces", m.elements * per_element + blocks + 3 * v, rotations + blocks + v, 0.0,
+      m.elements * fused_element_flops() + rotation_flops(in.counts, m.elements),
+      m.elements * per_element + blocks + 3 * v);
+  return {forces, compose};
 }
 
-std::vector<PhaseWork> count_work(const ElementKernelsStepper& stepper, const Scene& scene,
-                                  const WorkCounts& counts) {
-  // Block Jacobi: per solve, each diagonal block read and its inverse written.
-  const ch01::MeshSizes m = ch01::mesh_sizes(scene);
-  return fused_work(stepper, scene, counts, ch07::block_jacobi(m), m.nodes * kBlock,
-                    m.nodes * kBlock);
+PhaseWork pcg_solve_work(const WorkInput& in, const PreconditionerWork& preconditioner) {
+  // The PCG's own kernels as chapter 01 counts them: the product and three vector updates.
+  const double v = in.m.vector_bytes, matrix = ch07::matrix_bytes(in.A);
+  const double entries = 9.0 * double(in.A.blocks.size());
+  const PhaseWork own = ch01::phase_work("pcg", matrix + v + 3 * 2 * v, v + 3 * v, v,
+                                         2 * entries + 10 * in.m.dofs, matrix + 5 * v);
+  return solve_work(in, own, preconditioner);
 }
 
-ExecutedWork executed_work(const ElementKernelsStepper& stepper) {
-  const FusedElements& e = stepper.elements();
+PhaseWork solve_work(const WorkInput& in, const PhaseWork& own,
+                     const PreconditionerWork& preconditioner) {
+  PhaseWork solve = ch01::pcg_work(in.m, in.counts.cg_iterations, own, preconditioner.apply);
+  solve.add_part(
+      ch01::phase_work("prepare", preconditioner.prepare_read, preconditioner.prepare_written,
+                       preconditioner.prepare_written, 0.0,
+                       preconditioner.prepare_read + preconditioner.prepare_written),
+      1.0);
+  return solve;
+}
+
+PreconditionerWork block_jacobi_work(const WorkInput& in) {
+  return {ch07::block_jacobi(in.m), in.m.nodes * kBlock, in.m.nodes * kBlock};
+}
+
+ElementWork element_work(const SerialElements&, const WorkInput& in) { return fused_pass_work(in); }
+
+PreconditionerWork preconditioner_work(const PcgBlockJacobi&, const WorkInput& in) {
+  return block_jacobi_work(in);
+}
+
+PhaseWork solver_work(const SerialPcg&, const WorkInput& in,
+                      const PreconditionerWork& preconditioner) {
+  return pcg_solve_work(in, preconditioner);
+}
+
+ExecutedWork fused_counters(const FusedElements& e) {
   const double steps = e.shapes().empty() ? 0.0 : double(e.total_rotations()) / e.shapes().size();
   return {steps, double(e.total_rotations()), double(e.total_newton_iterations()),
           double(e.total_fallbacks())};
+}
+
+ExecutedWork element_counters(const SerialElements& part, double) {
+  return fused_counters(part.fused());
 }
 
 double fused_element_flops() {

@@ -74,8 +74,10 @@ std::string threads_element_table(const Scene& scene, int steps) {
   for (const auto& [name, how] : {std::pair{"colouring", ch09::ElementParallelism::colouring},
                                   std::pair{"per-node gather", ch09::ElementParallelism::gather}})
     for (const int threads : all > 1 ? std::vector<int>{1, all} : std::vector<int>{1}) {
-      auto stepper = std::make_unique<ch09::ThreadsStepper>(scene, SolverSettings{}, how);
-      colours = std::max(colours, stepper->colours());
+      ch09::ThreadsStepper::Params params;
+      params.elements.parallelism = how;
+      auto stepper = std::make_unique<ch09::ThreadsStepper>(scene, SolverSettings{}, params);
+      colours = std::max(colours, stepper->elements().colours());
       runs.push_back({name, threads, std::move(stepper), rest_state(scene), {}});
     }
   for (int k = 0; k < steps + 2; ++k)

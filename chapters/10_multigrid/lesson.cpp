@@ -72,7 +72,7 @@ RunStats run_chapter(MultigridStepper& stepper, const Scene& scene, int steps) {
     if ((k + 1) % std::max(1, steps / 4) == 0)
       std::cerr << "  step " << k + 1 << "/" << steps << "\n" << std::flush;
   }
-  out.refreshes = stepper.multigrid().refresh_rule().refreshes();
+  out.refreshes = stepper.preconditioner().multigrid().refresh_rule().refreshes();
   return out;
 }
 
@@ -192,9 +192,9 @@ FromZero from_zero(MultigridStepper& stepper, const Scene& scene, const SolverSe
       pcg.solve(A, M, b, solver, y);
     });
   };
-  VCyclePreconditioner v_cycle(stepper.multigrid());
+  VCyclePreconditioner v_cycle(stepper.preconditioner().multigrid());
   solve(v_cycle, out.v_cycle, out.v_cycle_ms);
-  ch09::BlockJacobi block_jacobi(stepper.diagonal_blocks());
+  ch09::BlockJacobi block_jacobi(stepper.system().index.diagonal);
   solve(block_jacobi, out.jacobi, out.jacobi_ms);
   const Eigen::SparseMatrix<double> csc = A.to_sparse();
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,
@@ -229,7 +229,7 @@ void export_system(const LessonRun& run, const MultigridStepper& stepper, const 
   summary["tolerance"] = solver_from_args(run.args).tolerance;
   summary["ours_iterations"] = z.v_cycle.iterations;
   summary["block_jacobi_iterations"] = z.jacobi.iterations;
-  summary["ours_levels"] = stepper.multigrid().levels();
+  summary["ours_levels"] = stepper.preconditioner().multigrid().levels();
   write_json_file(dir + "/summary.json", summary);
   std::cerr << "wrote " << dir << "/{A,b,B}.mtx and summary.json\n";
 }
@@ -291,10 +291,10 @@ std::string multigrid_table(const LessonRun& run) {
             << solver.tolerance << ", smoother " << args.get("smoother") << ", " << max_threads()
             << " thread(s)\n";
   const auto setup_start = Clock::now();
-  MultigridStepper stepper(scene, solver, settings);
+  MultigridStepper stepper(scene, solver, multigrid_params<MultigridRecipe>(settings));
   const double setup_ms = 1e3 * std::chrono::duration<double>(Clock::now() - setup_start).count();
   const RunStats stats = run_chapter(stepper, scene, run.steps);
-  Multigrid& mg = stepper.multigrid();
+  Multigrid& mg = stepper.preconditioner().multigrid();
   print_hierarchy(mg, setup_ms);
   std::cerr << "measuring the last system: costs per level, PCG with three preconditioners\n"
             << std::flush;

@@ -7,56 +7,23 @@
 // guess is extrapolated from the last solutions.
 #pragma once
 
-#include "chapters/09_threads/parallel_pcg.hpp"
-#include "chapters/09_threads/stepper.hpp"
-#include "chapters/10_multigrid/multigrid.hpp"
+#include "chapters/08_element_kernels/serial_parts.hpp"
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/09_threads/parts.hpp"
+#include "chapters/09_threads/threaded_elements.hpp"
+#include "chapters/10_multigrid/parts.hpp"
 
 namespace fem::ch10 {
 
-// The stepper's settings: the hierarchy's, and the PCG's guess.
-struct MultigridStepperSettings {
-  MultigridSettings multigrid;
-  // The guess: the polynomial through the last extrapolation + 1 solutions one step ahead
-  // (0: the last solution, chapter 09's warm start; 1: 2 y_n - y_(n-1); 2: 3 y_n - 3 y_(n-1)
-  // + y_(n-2)).
-  int extrapolation = 2;
-};
-// check(settings.multigrid) and the extrapolation's order; throws std::invalid_argument.
-void check(const MultigridStepperSettings& settings);
-
-// One V-cycle of the hierarchy as the preconditioner of chapter 09's PCG: prepare() gives
-// the hierarchy this solve's matrix (factorize), apply() runs one cycle from a zero guess.
-class VCyclePreconditioner final : public ch09::Preconditioner {
- public:
-  explicit VCyclePreconditioner(Multigrid& multigrid) : multigrid_(multigrid) {}
-  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
-  bool block_diagonal() const override { return false; }
-  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
-
- private:
-  Multigrid& multigrid_;
+struct MultigridRecipe {
+  using Order = ch08::MeshOrder;                   // chapter 08's
+  using Team = ch09::TeamOfThreads;                // chapter 09's
+  using Elements = ch09::ThreadedElements;         // chapter 09's
+  using Guess = Extrapolation;                     // new: from the last three solutions
+  using Preconditioner = MultigridPreconditioner;  // new: one V-cycle
+  using Solver = ch09::ParallelPcgSolver;          // chapter 09's
 };
 
-// Not final: a derived stepper may run this step on other data (a renumbered mesh).
-class MultigridStepper : public ch09::ThreadsStepper {
- public:
-  MultigridStepper(
-      const Scene& scene, const SolverSettings& settings,
-      const MultigridStepperSettings& multigrid = {},
-      ch09::ElementParallelism element_parallelism = ch09::ElementParallelism::colouring);
-
-  const Multigrid& multigrid() const { return multigrid_; }
-  Multigrid& multigrid() { return multigrid_; }
-
- private:
-  // Chapter 09's solve from a guess extrapolated from the last solutions.
-  void solve() override;
-
-  Multigrid multigrid_;  // its pattern analysed from the system matrix's
-  VCyclePreconditioner v_cycle_{multigrid_};
-  int extrapolation_;           // the guess's order: 0, 1 or 2
-  Eigen::VectorXd history_[2];  // the solutions of the two steps before the last
-  int solves_ = 0;
-};
+using MultigridStepper = ch08::StepOf<MultigridRecipe>;
 
 }  // namespace fem::ch10

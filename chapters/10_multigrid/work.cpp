@@ -108,25 +108,24 @@ PhaseWork v_cycle_work(const std::vector<LevelSize>& levels, int products, int s
   return w;
 }
 
-std::vector<PhaseWork> multigrid_work(const MultigridStepper& stepper, const Scene& scene,
-                                      const WorkCounts& counts, int scalar, bool float_arithmetic) {
-  const Multigrid& mg = stepper.multigrid();
+ch08::PreconditionerWork multigrid_work(const Multigrid& mg, const ch08::WorkInput& in, int scalar,
+                                        bool float_arithmetic) {
   const PhaseWork v_cycle =
       v_cycle_work(multigrid_levels(mg), smoother_products(mg), scalar, float_arithmetic);
   // Per solve: the fine level's inverse diagonal from A's diagonal blocks; in float, every
   // fine block read in double and written in float too.
-  const double nodes = scene.mesh.num_nodes();
+  const double nodes = in.scene.mesh.num_nodes();
   double read = nodes * kBlock, written = nodes * 9.0 * scalar;
   if (scalar < 8) {
-    read += double(stepper.system_matrix().blocks.size()) * kBlock;
-    written += double(stepper.system_matrix().blocks.size()) * 9.0 * scalar;
+    read += double(in.A.blocks.size()) * kBlock;
+    written += double(in.A.blocks.size()) * 9.0 * scalar;
   }
-  return ch08::fused_work(stepper, scene, counts, v_cycle, read, written);
+  return {v_cycle, read, written};
 }
 
-std::vector<PhaseWork> count_work(const MultigridStepper& stepper, const Scene& scene,
-                                  const WorkCounts& counts) {
-  return multigrid_work(stepper, scene, counts, 8, false);
+ch08::PreconditionerWork preconditioner_work(const MultigridPreconditioner& part,
+                                             const ch08::WorkInput& in) {
+  return multigrid_work(part.multigrid(), in, 8, false);
 }
 
 }  // namespace fem::ch10

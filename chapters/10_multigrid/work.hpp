@@ -1,24 +1,29 @@
-// This chapter's work per phase (chapters/work.hpp: the model): the fused pass's phases as
-// before, and a solve whose preconditioner is one V-cycle per iteration over every level of
-// the hierarchy, each level's kernels a part of the solve at their own working set; the counts of
-// one V-cycle for the chapters that keep it.
+// This chapter's preconditioner's work (chapters/08_element_kernels/work.hpp: counted part by
+// part): one V-cycle per iteration over every level of the hierarchy, each level's kernels a
+// part of the solve at their own working set; the counts of one V-cycle for the chapters that
+// keep it.
 #pragma once
 
 #include <vector>
 
+#include "chapters/08_element_kernels/work.hpp"
 #include "chapters/10_multigrid/multigrid.hpp"
-#include "chapters/10_multigrid/stepper.hpp"
+#include "chapters/10_multigrid/parts.hpp"
 #include "chapters/work.hpp"
 
 namespace fem::ch10 {
 
-std::vector<PhaseWork> count_work(const MultigridStepper& stepper, const Scene& scene,
-                                  const WorkCounts& counts);
-
-// The V-cycle chapters' phases, the levels' numbers and vectors at `scalar` bytes (8: double,
-// 4: float), the V-cycle's flops in float arithmetic or in double.
-std::vector<PhaseWork> multigrid_work(const MultigridStepper& stepper, const Scene& scene,
-                                      const WorkCounts& counts, int scalar, bool float_arithmetic);
+ch08::PreconditionerWork preconditioner_work(const MultigridPreconditioner& part,
+                                             const ch08::WorkInput& in);
+// The V-cycle alone is not timed in double (chapter 12 times its float smoothing step).
+inline std::vector<PartKernel> preconditioner_kernels(MultigridPreconditioner&,
+                                                      const ch08::KernelInput&) {
+  return {};
+}
+// A V-cycle of `multigrid` applied once, its levels' numbers and vectors at `scalar` bytes (8:
+// double, 4: float), its flops in float arithmetic or in double, and its set-up per solve.
+ch08::PreconditionerWork multigrid_work(const Multigrid& multigrid, const ch08::WorkInput& in,
+                                        int scalar, bool float_arithmetic);
 
 // One level of the hierarchy as the counts need it.
 struct LevelSize {

@@ -51,7 +51,8 @@ std::vector<Run> runs_for(const LessonRun& run) {
 
 // One row: the order's measures of memory distance, and its times (1 thread, medians).
 std::string row(Run& r) {
-  const OrderQuality q = order_quality(renumbered(r.scene, r.stepper->order(), false).mesh);
+  const OrderQuality q =
+      order_quality(renumbered(r.scene, r.stepper->order().node_order(), false).mesh);
   const auto& A = r.stepper->system_matrix();
   Eigen::VectorXd x = Eigen::VectorXd::Ones(3 * A.block_rows()), y(x.size());
   const double spmv = time_ms(
@@ -59,11 +60,11 @@ std::string row(Run& r) {
   const Eigen::VectorXd rhs = r.stepper->system_rhs();
   Eigen::VectorXd s(rhs.size());
   const double v_cycle = time_ms(
-      20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
+      20, [&] { r.stepper->preconditioner().multigrid().apply(rhs, s); }, 2.0);
   const int n = r.scene.mesh.num_nodes();
   std::ostringstream out;
   out << "| " << r.name << " | " << q.bandwidth << " | " << fixed(q.profile / n, 0) << " | "
-      << fixed(q.element_spread, 0) << " | " << r.stepper->colours() << " | "
+      << fixed(q.element_spread, 0) << " | " << r.stepper->elements().colours() << " | "
       << fixed(median(r.element_ms), 2) << " | " << fixed(spmv, 3) << " | " << fixed(v_cycle, 3)
       << " | " << median(r.iterations) << " |\n";
   return out.str();
@@ -72,7 +73,9 @@ std::string row(Run& r) {
 std::string one_mesh_table(const LessonRun& run) {
   std::vector<Run> runs = runs_for(run);
   for (Run& r : runs) {
-    r.stepper = std::make_unique<NodeOrderStepper>(r.scene, SolverSettings{}, r.ordering);
+    NodeOrderStepper::Params params;
+    params.order.ordering = r.ordering;
+    r.stepper = std::make_unique<NodeOrderStepper>(r.scene, SolverSettings{}, params);
     r.state = rest_state(r.scene);
   }
   // Interleaved, one step of each order in turn, as fem_bench runs chapters: a drift of the

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -10,6 +11,7 @@
 #include <string>
 
 #include "chapters/11_node_order/node_order.hpp"
+#include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "common/cli.hpp"
 #include "common/mesh.hpp"
@@ -29,12 +31,22 @@ const Variant kVariants[] = {{"double (chapter 11)", std::nullopt},
                              {"float", Arithmetic::single},
                              {"float numbers, double arithmetic", Arithmetic::double_on_float}};
 
+// Chapter 12's recipe with its float numbers widened to double in registers.
+struct HalfTheBytesWidened : HalfTheBytes {
+  using Preconditioner = ReducedMultigrid<double>;
+};
+
 // One variant of the preconditioner: a stepper at the default tolerance (times, iterations)
 // and one at each tight tolerance (iterations), stepped side by side.
 struct Run {
   Variant variant;
-  std::unique_ptr<ch11::NodeOrderStepper> stepper;
-  std::vector<std::unique_ptr<ch11::NodeOrderStepper>> tight;
+  std::unique_ptr<Stepper> stepper;
+  std::vector<std::unique_ptr<Stepper>> tight;
+  // One V-cycle of the stepper's preconditioner, outside a team (on this thread), and the
+  // bytes of its float numbers (0 for chapter 11's in double).
+  std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)> v_cycle;
+  long long float_bytes = 0;
+  const Eigen::VectorXd* rhs = nullptr;  // the last step's filtered right-hand side
   State state;
   std::vector<State> tight_state;
   std::vector<double> solve_ms, iterations;
@@ -42,23 +54,37 @@ struct Run {
   bool converged = true;
 };
 
-std::unique_ptr<ch11::NodeOrderStepper> make(const Scene& scene, const Variant& variant,
-                                             double tolerance) {
+template <class S>
+std::unique_ptr<Stepper> made(std::unique_ptr<S> stepper, Run* timed) {
+  if (timed) {
+    ch09::Preconditioner* M = &stepper->preconditioner().pcg_preconditioner();
+    timed->v_cycle = [M](const Eigen::VectorXd& r, Eigen::VectorXd& s) {
+      M->apply(ch09::RowChunks{}, r, s);
+    };
+    timed->rhs = &stepper->system_rhs();
+    if constexpr (std::is_same_v<S, HalfBytesStepper>)
+      timed->float_bytes = stepper->preconditioner().v_cycle().number_bytes();
+  }
+  return stepper;
+}
+
+// The variant's stepper; `timed` (the default tolerance's run) gets its V-cycle.
+std::unique_ptr<Stepper> make(const Scene& scene, const Variant& variant, double tolerance,
+                              Run* timed = nullptr) {
   SolverSettings settings;
   settings.tolerance = tolerance;
-  if (!variant.arithmetic) return std::make_unique<ch11::NodeOrderStepper>(scene, settings);
-  return std::make_unique<HalfBytesStepper>(scene, settings, *variant.arithmetic);
+  if (!variant.arithmetic)
+    return made(std::make_unique<ch11::NodeOrderStepper>(scene, settings), timed);
+  if (*variant.arithmetic == Arithmetic::single)
+    return made(std::make_unique<HalfBytesStepper>(scene, settings), timed);
+  return made(std::make_unique<ch08::StepOf<HalfTheBytesWidened>>(scene, settings), timed);
 }
 
 double v_cycle_ms(Run& r) {
-  const Eigen::VectorXd rhs = r.stepper->system_rhs();
+  const Eigen::VectorXd rhs = *r.rhs;
   Eigen::VectorXd s(rhs.size());
-  if (!r.variant.arithmetic)
-    return time_ms(
-        20, [&] { r.stepper->multigrid().apply(rhs, s); }, 2.0);
-  auto& v_cycle = static_cast<HalfBytesStepper&>(*r.stepper).v_cycle();
   return time_ms(
-      20, [&] { v_cycle.apply(ch09::RowChunks{}, rhs, s); }, 2.0);
+      20, [&] { r.v_cycle(rhs, s); }, 2.0);
 }
 
 std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tight) {
@@ -66,7 +92,7 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
   for (const Variant& variant : kVariants) {
     Run& r = runs.emplace_back();
     r.variant = variant;
-    r.stepper = make(run.scene, variant, SolverSettings{}.tolerance);
+    r.stepper = make(run.scene, variant, SolverSettings{}.tolerance, &r);
     r.state = rest_state(run.scene);
     for (const double t : tight) {
       r.tight.push_back(make(run.scene, variant, t));
@@ -91,8 +117,7 @@ std::string one_mesh_table(const LessonRun& run, const std::vector<double>& tigh
     }
   }
   // Chapter 10's numbers in double take twice the float ones' bytes (the tests check it).
-  auto& single = static_cast<HalfBytesStepper&>(*runs[1].stepper).v_cycle();  // Arithmetic::single
-  const long long bytes = 2 * static_cast<ReducedVCycle<float>&>(single).number_bytes();
+  const long long bytes = 2 * runs[1].float_bytes;  // Arithmetic::single
   const double mb = 1e-6 * static_cast<double>(bytes);
   std::ostringstream out;
   out << "| " << mesh_name(run.scene) << " (" << run.scene.mesh.num_nodes() << " nodes), V-cycle"

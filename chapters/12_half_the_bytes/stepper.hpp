@@ -5,34 +5,23 @@
 // register, where Eigen's fixed-size 3x3 types leave most lanes empty.
 #pragma once
 
-#include <memory>
-
-#include "chapters/11_node_order/stepper.hpp"
-#include "chapters/12_half_the_bytes/element_batch.hpp"
-#include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/09_threads/parts.hpp"
+#include "chapters/10_multigrid/parts.hpp"
+#include "chapters/11_node_order/renumbered_nodes.hpp"
+#include "chapters/12_half_the_bytes/parts.hpp"
 
 namespace fem::ch12 {
 
-class HalfBytesStepper : public ch11::NodeOrderStepper {
- public:
-  // single: the V-cycle in float on float numbers (the default); double_on_float: the same
-  // float numbers, widened to double in registers (the lesson measures both).
-  HalfBytesStepper(const Scene& scene, const SolverSettings& settings,
-                   Arithmetic arithmetic = Arithmetic::single,
-                   const ch10::MultigridStepperSettings& multigrid = {});
-
-  Arithmetic arithmetic() const { return arithmetic_; }
-  const BatchedElements& batched_elements() const { return batched_; }
-  // The preconditioner (the lesson times it alone; outside a team it runs on one thread).
-  ch09::Preconditioner& v_cycle() { return *v_cycle_; }
-
- private:
-  // Chapter 09's colouring (chapter 11's slabs), each group in batches of kLanes elements.
-  void element_pass(const State& state) override;
-
-  Arithmetic arithmetic_;
-  BatchedElements batched_;
-  std::unique_ptr<ch09::Preconditioner> v_cycle_;  // reads multigrid(): declared after it
+struct HalfTheBytes {
+  using Order = ch11::RenumberedNodes;             // chapter 11's
+  using Team = ch09::TeamOfThreads;                // chapter 09's
+  using Elements = BatchedElementPass;             // new: one element per lane
+  using Guess = ch10::Extrapolation;               // chapter 10's
+  using Preconditioner = ReducedMultigrid<float>;  // new: the V-cycle in float
+  using Solver = ch09::ParallelPcgSolver;          // chapter 09's
 };
+
+using HalfBytesStepper = ch08::StepOf<HalfTheBytes>;
 
 }  // namespace fem::ch12

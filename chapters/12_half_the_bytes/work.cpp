@@ -1,20 +1,14 @@
 #include "chapters/12_half_the_bytes/work.hpp"
 
-#include "chapters/09_threads/work.hpp"
-#include "chapters/10_multigrid/work.hpp"
-
 namespace fem::ch12 {
 
-std::vector<PhaseWork> count_work(const HalfBytesStepper& stepper, const Scene& scene,
-                                  const WorkCounts& counts) {
-  return ch10::multigrid_work(stepper, scene, counts, sizeof(float),
-                              stepper.arithmetic() == Arithmetic::single);
+ch08::ElementWork element_work(const BatchedElementPass&, const ch08::WorkInput& in) {
+  return ch08::fused_pass_work(in);
 }
 
-ExecutedWork executed_work(const HalfBytesStepper& stepper) {
-  const BatchedElements& e = stepper.batched_elements();
-  const double elements = stepper.elements().shapes().size();
-  ExecutedWork w = ch09::executed_work(stepper);  // the team and the synchronizations
+ExecutedWork element_counters(const BatchedElementPass& part, double elements) {
+  const BatchedElements& e = part.batched_elements();
+  ExecutedWork w;
   w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;
   w.rotations = double(e.total_rotations());
   w.rotation_iterations = double(e.total_newton_iterations());

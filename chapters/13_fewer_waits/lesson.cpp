@@ -8,6 +8,7 @@
 
 #include "chapters/12_half_the_bytes/work.hpp"
 #include "chapters/13_fewer_waits/stepper.hpp"
+#include "chapters/13_fewer_waits/work.hpp"
 
 namespace fem::ch13 {
 
@@ -17,9 +18,9 @@ namespace {
 double solve_bytes(const FewerWaitsStepper& stepper, const Scene& scene, double iterations) {
   WorkCounts counts;
   counts.cg_iterations = iterations;
-  for (const PhaseWork& phase : ch12::count_work(stepper, scene, counts))
+  for (const PhaseWork& phase : ch08::count_work(stepper, scene, counts))
     if (phase.phase == "solve") return phase.bytes();
-  throw std::logic_error("chapter 12's work has no solve phase");
+  throw std::logic_error("the stepper's work has no solve phase");
 }
 
 // The table's rows: a name and what it changes in the chapter's settings (the first: nothing).
@@ -88,7 +89,7 @@ std::string one_mesh_table(const LessonRun& run) {
   }
   t << "\n"
     << scene.name << ", mean of " << run.steps << " steps after " << warmup
-    << "; the roofline's solve bytes (chapter 12's `count_work`; refreshes not counted). "
+    << "; the roofline's solve bytes (the parts' `count_work`; refreshes not counted). "
        "`fem_lessons iterations --steps "
     << run.steps << "`.\n";
   return t.str();
@@ -107,7 +108,7 @@ void add_options(ArgParser& args) {
 IterationCost iteration_cost(const Scene& scene, const SolverSettings& solver,
                              const ch10::MultigridStepperSettings& settings, int warmup,
                              int steps) {
-  FewerWaitsStepper stepper(scene, solver, settings);
+  FewerWaitsStepper stepper(scene, solver, ch10::multigrid_params<FewerWaits>(settings));
   State state = rest_state(scene);
   std::vector<double> iterations;
   for (int k = 0; k < warmup + steps; ++k) {
@@ -120,14 +121,14 @@ IterationCost iteration_cost(const Scene& scene, const SolverSettings& solver,
     if (k >= warmup) iterations.push_back(p.cg_iterations);
   }
   IterationCost c;
-  c.levels = stepper.multigrid().levels();
+  c.levels = stepper.preconditioner().multigrid().levels();
   c.median_iterations = median(iterations);
   double sum = 0.0;
   for (const double it : iterations) sum += it;
   c.mean_iterations = iterations.empty() ? 0.0 : sum / double(iterations.size());
   c.bytes_per_iteration = solve_bytes(stepper, scene, 1.0) - solve_bytes(stepper, scene, 0.0);
   c.bytes_per_step = solve_bytes(stepper, scene, c.mean_iterations);
-  c.refreshes = stepper.multigrid().refresh_rule().refreshes();
+  c.refreshes = stepper.preconditioner().multigrid().refresh_rule().refreshes();
   return c;
 }
 

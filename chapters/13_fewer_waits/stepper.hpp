@@ -4,26 +4,24 @@
 // reads only its own rows can run inside the loop before it.
 #pragma once
 
-#include "chapters/12_half_the_bytes/stepper.hpp"
-#include "chapters/13_fewer_waits/fused_v_cycle.hpp"
-#include "chapters/13_fewer_waits/single_reduction_pcg.hpp"
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/09_threads/parts.hpp"
+#include "chapters/10_multigrid/parts.hpp"
+#include "chapters/11_node_order/renumbered_nodes.hpp"
+#include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/13_fewer_waits/parts.hpp"
 
 namespace fem::ch13 {
 
-class FewerWaitsStepper final : public ch12::HalfBytesStepper {
- public:
-  FewerWaitsStepper(const Scene& scene, const SolverSettings& settings,
-                    const ch10::MultigridStepperSettings& multigrid = {});
-
-  ch09::Preconditioner& fused_v_cycle() { return fused_; }
-
- private:
-  // Chronopoulos and Gear's PCG on the fused cycle (chapter 09's PCG where the hierarchy has
-  // nothing to fuse: one level, or a finest level on one thread).
-  SolveStats solve_filtered_system(Eigen::VectorXd& y) override;
-
-  FusedVCycle fused_;
-  SingleReductionPcg single_reduction_;
+struct FewerWaits {
+  using Order = ch11::RenumberedNodes;         // chapter 11's
+  using Team = ch09::TeamOfThreads;            // chapter 09's
+  using Elements = ch12::BatchedElementPass;   // chapter 12's
+  using Guess = ch10::Extrapolation;           // chapter 10's
+  using Preconditioner = FusedPreconditioner;  // new: chapter 12's cycle in fused loops
+  using Solver = SingleReductionSolver;        // new: one wait per reduction
 };
+
+using FewerWaitsStepper = ch08::StepOf<FewerWaits>;
 
 }  // namespace fem::ch13

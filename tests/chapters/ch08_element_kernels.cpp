@@ -115,8 +115,8 @@ TEST_CASE("ch08: the closed-form blocks equal common's dfdx_block for every elem
   std::array<Eigen::Matrix3d, 10> K;
   double largest = 0.0;
   for (std::size_t e = 0; e < model.tets.size(); ++e) {
-    const Eigen::Matrix3d R = stepper.elements().rotations()[e].toRotationMatrix();
-    const ch08::ElementShape& shape = stepper.elements().shapes()[e];
+    const Eigen::Matrix3d R = stepper.elements().fused().rotations()[e].toRotationMatrix();
+    const ch08::ElementShape& shape = stepper.elements().fused().shapes()[e];
     ch08::stiffness_blocks(ch08::rotated_gradients(R, shape.Dm_inv), shape.mu_volume,
                            shape.lambda_volume, K);
     const Matrix12d expected = -element_dfdx(model.rest[e], R);
@@ -171,7 +171,7 @@ TEST_CASE("ch08: an inverted element takes the SVD fallback and the system stays
   State a = state, b = state;
   separate.step(a);
   fused.step(b);
-  CHECK(fused.elements().last_step_fallbacks() >= 1);
+  CHECK(fused.elements().fused().last_step_fallbacks() >= 1);
   const Eigen::SparseMatrix<double> A07 = separate.system_matrix().to_sparse();
   CHECK((A07 - fused.system_matrix().to_sparse()).norm() <= 1e-13 * A07.norm());
   const Eigen::VectorXd& b07 = separate.system_rhs();
@@ -195,9 +195,10 @@ TEST_CASE("ch08: a stepper created on a turned body starts cold and then warm", 
     fused.step(b);
     INFO("step " << k);
     if (k == 0)
-      CHECK(fused.elements().last_step_fallbacks() ==
+      CHECK(fused.elements().fused().last_step_fallbacks() ==
             static_cast<long long>(scene.mesh.num_tets()));
-    if (k > 0) CHECK(fused.elements().last_step_fallbacks() == 0);  // warm from the SVD's rotations
+    if (k > 0)
+      CHECK(fused.elements().fused().last_step_fallbacks() == 0);  // warm from the SVD's rotations
     const Eigen::SparseMatrix<double> A07 = separate.system_matrix().to_sparse();
     CHECK((A07 - fused.system_matrix().to_sparse()).norm() <= 1e-13 * A07.norm());
     const Eigen::VectorXd& b07 = separate.system_rhs();
@@ -213,7 +214,7 @@ TEST_CASE("ch08: no element of the test scenes needs the SVD fallback", "[ch08]"
     State state = rest_state(scene);
     for (int k = 0; k < 50; ++k) stepper.step(state);
     INFO(scene.name);
-    CHECK(stepper.elements().total_fallbacks() == 0);
+    CHECK(stepper.elements().fused().total_fallbacks() == 0);
   }
 }
 

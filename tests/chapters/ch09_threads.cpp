@@ -22,8 +22,8 @@ std::vector<int> thread_counts() {
 
 State run_with(const Scene& scene, int threads, int steps, ch09::ElementParallelism how) {
   const ThreadCountScope scope(threads);
-  ch09::ThreadsStepper stepper(scene, {}, how);
-  stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
+  ch09::ThreadsStepper stepper(scene, {}, ch09::parallelism(how));
+  stepper.team().adaptive_team().set_enabled(false);  // really this many threads, every step
   State state = rest_state(scene);
   for (int k = 0; k < steps; ++k) stepper.step(state);
   return state;
@@ -58,9 +58,11 @@ TEST_CASE("ch09: the system equals chapter 08's, by either element pass", "[ch09
   const Scene scene = test::driven_scene();
   const ThreadCountScope threads(openmp_enabled() ? 2 : 1);
   ch08::ElementKernelsStepper serial(scene, test::tight_solver());
-  ch09::ThreadsStepper colouring(scene, test::tight_solver(), ch09::ElementParallelism::colouring);
-  ch09::ThreadsStepper gather(scene, test::tight_solver(), ch09::ElementParallelism::gather);
-  CHECK(colouring.colours() > 1);
+  ch09::ThreadsStepper colouring(scene, test::tight_solver(),
+                                 ch09::parallelism(ch09::ElementParallelism::colouring));
+  ch09::ThreadsStepper gather(scene, test::tight_solver(),
+                              ch09::parallelism(ch09::ElementParallelism::gather));
+  CHECK(colouring.elements().colours() > 1);
   State state = rest_state(scene);
   for (int k = 0; k < 5; ++k) {
     State a = state, b = state, c = state;  // the same input state: only rounding may differ
@@ -90,7 +92,7 @@ TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thr
   for (const int threads : thread_counts()) {
     const ThreadCountScope scope(threads);
     ch09::ParallelPcg pcg(A, scene.constraints);
-    ch09::BlockJacobi block_jacobi(stepper.diagonal_blocks());
+    ch09::BlockJacobi block_jacobi(stepper.system().index.diagonal);
     Eigen::VectorXd y = Eigen::VectorXd::Zero(b.size()), Ay(b.size());
     const SolveStats result = pcg.solve(A, block_jacobi, b, test::tight_solver(), y);
     A.multiply(y, Ay);
@@ -178,9 +180,10 @@ TEST_CASE("ch09: each phase counts its own synchronizations, and they add up to 
   for (const ChapterInfo& chapter : chapters()) {
     if (!chapter.variant_of.empty()) continue;
     INFO(chapter.id);
+    // The team of two on every step: the adaptive team off for the steppers made here.
+    ::setenv("FEM_ADAPTIVE_TEAM", "0", 1);
     const auto stepper = chapter.make(scene, {});
-    if (auto* threads = dynamic_cast<ch09::ThreadsStepper*>(stepper.get()))
-      threads->adaptive_team().set_enabled(false);  // the team of two on every step
+    ::unsetenv("FEM_ADAPTIVE_TEAM");
     State state = rest_state(scene);
     stepper->step(state);
     const Synchronizations seen = syncs_during([&] { stepper->step(state); });

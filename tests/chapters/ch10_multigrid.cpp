@@ -61,8 +61,8 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
   const auto run_with = [](const Scene& scene, int threads,
                            const ch10::MultigridStepperSettings& s) {
     const ThreadCountScope scope(threads);
-    ch10::MultigridStepper stepper(scene, {}, s);
-    stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
+    ch10::MultigridStepper stepper(scene, {}, ch10::multigrid_params<ch10::MultigridRecipe>(s));
+    stepper.team().adaptive_team().set_enabled(false);  // really this many threads, every step
     State state = rest_state(scene);
     for (int k = 0; k < 50; ++k) stepper.step(state);
     return state;
@@ -86,10 +86,11 @@ TEST_CASE("ch10: bit-identical states after 50 steps with 1, 2 and 3 threads", "
 TEST_CASE("ch10: the V-cycle is symmetric positive definite on the filtered space", "[ch10]") {
   for (const Scene& scene : all_scenes()) {
     for (const Smoother smoother : kSmoothers) {
-      ch10::MultigridStepper stepper(scene, {}, three_levels(smoother));
+      ch10::MultigridStepper stepper(
+          scene, {}, ch10::multigrid_params<ch10::MultigridRecipe>(three_levels(smoother)));
       State state = rest_state(scene);
       for (int k = 0; k < 3; ++k) stepper.step(state);
-      ch10::Multigrid& mg = stepper.multigrid();
+      ch10::Multigrid& mg = stepper.preconditioner().multigrid();
       REQUIRE(mg.levels() == 3);
       std::srand(10);
       const Eigen::Index n = stepper.system_rhs().size();
@@ -112,15 +113,16 @@ TEST_CASE("ch10: every coarse matrix equals P^T A P computed by Eigen after a re
   // The default refresh rule keeps the coarse matrices for several steps: step until a refresh
   // past the first one (the prolongator is smoothed on the first), then compare.
   for (const Scene& scene : all_scenes()) {
-    ch10::MultigridStepper stepper(scene, {}, three_levels());
+    ch10::MultigridStepper stepper(scene, {},
+                                   ch10::multigrid_params<ch10::MultigridRecipe>(three_levels()));
     State state = rest_state(scene);
     stepper.step(state);
     int steps = 1;
     do {
       stepper.step(state);
       ++steps;
-    } while (!stepper.multigrid().refresh_rule().refreshed() && steps < 100);
-    const ch10::Multigrid& mg = stepper.multigrid();
+    } while (!stepper.preconditioner().multigrid().refresh_rule().refreshed() && steps < 100);
+    const ch10::Multigrid& mg = stepper.preconditioner().multigrid();
     REQUIRE(mg.refresh_rule().refreshed());
     REQUIRE(mg.levels() == 3);
     // The finest level is the stepper's filtered system itself.
@@ -146,11 +148,12 @@ TEST_CASE("ch10: a mode is unused exactly where its prolongator column is zero",
     for (const Scene& scene : all_scenes()) {
       ch10::MultigridStepperSettings settings = three_levels();
       settings.multigrid.coarsening.modes = modes;
-      ch10::MultigridStepper stepper(scene, {}, settings);
+      ch10::MultigridStepper stepper(scene, {},
+                                     ch10::multigrid_params<ch10::MultigridRecipe>(settings));
       State state = rest_state(scene);
       stepper.step(state);
       CHECK(stepper.profile().converged);
-      const ch10::Multigrid& mg = stepper.multigrid();
+      const ch10::Multigrid& mg = stepper.preconditioner().multigrid();
       for (int l = 0; l + 1 < mg.levels(); ++l) {
         const Eigen::SparseMatrix<double> P = ch10::prolongator(mg, l);
         const Eigen::VectorXd unused = ch10::missing_modes(mg, l + 1);
@@ -198,7 +201,8 @@ TEST_CASE("ch10: zero heap allocations per step after the first, with 2 threads"
     CHECK(test::allocations_per_step("10", scene) == 0);
     // The three-level hierarchy too, with either smoother.
     for (const Smoother smoother : kSmoothers) {
-      ch10::MultigridStepper stepper(scene, {}, three_levels(smoother));
+      ch10::MultigridStepper stepper(
+          scene, {}, ch10::multigrid_params<ch10::MultigridRecipe>(three_levels(smoother)));
       State state = rest_state(scene);
       stepper.step(state);
       alloc::Scope scope;
@@ -216,12 +220,12 @@ TEST_CASE("ch10: serial_rows runs the small levels on one thread, to the same bi
   const auto run = [&](int serial_rows, State& state) {
     ch10::MultigridStepperSettings s = three_levels();
     s.multigrid.rows.serial_rows = serial_rows;
-    ch10::MultigridStepper stepper(scene, {}, s);
-    stepper.adaptive_team().set_enabled(false);
+    ch10::MultigridStepper stepper(scene, {}, ch10::multigrid_params<ch10::MultigridRecipe>(s));
+    stepper.team().adaptive_team().set_enabled(false);
     state = rest_state(scene);
     for (int k = 0; k < 20; ++k) stepper.step(state);
-    std::vector<bool> serial = {stepper.multigrid().fine_level().rows.serial};
-    for (const auto& level : stepper.multigrid().coarse_levels())
+    std::vector<bool> serial = {stepper.preconditioner().multigrid().fine_level().rows.serial};
+    for (const auto& level : stepper.preconditioner().multigrid().coarse_levels())
       serial.push_back(level.rows.serial);
     return serial;
   };
@@ -240,10 +244,12 @@ TEST_CASE("ch10: set-up refuses a matrix of another pattern and bad settings", "
   const Scene scene = test::test_scene("cantilever");
   ch10::MultigridStepper stepper(scene, {});
   const std::vector<Eigen::Matrix3d> wrong(3, Eigen::Matrix3d::Identity());
-  CHECK_THROWS_AS(stepper.multigrid().factorize(wrong), std::invalid_argument);
+  CHECK_THROWS_AS(stepper.preconditioner().multigrid().factorize(wrong), std::invalid_argument);
   ch10::MultigridStepperSettings bad;
   bad.multigrid.coarsening.modes = 4;
-  CHECK_THROWS_AS(ch10::MultigridStepper(scene, {}, bad), std::invalid_argument);
+  CHECK_THROWS_AS(
+      ch10::MultigridStepper(scene, {}, ch10::multigrid_params<ch10::MultigridRecipe>(bad)),
+      std::invalid_argument);
 }
 
 TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle", "[ch10]") {
@@ -253,39 +259,44 @@ TEST_CASE("ch10: lagged coarse matrices give the same motion and an SPD V-cycle"
   every_step.multigrid.refresh.every = 1;
   lagged.multigrid.refresh.every = 5;  // every fifth step only: the rule without its early refresh
   lagged.multigrid.refresh.growth = 0.0;
-  ch10::MultigridStepper fresh(scene, test::tight_solver(), every_step);
-  ch10::MultigridStepper stale(scene, test::tight_solver(), lagged);
+  ch10::MultigridStepper fresh(scene, test::tight_solver(),
+                               ch10::multigrid_params<ch10::MultigridRecipe>(every_step));
+  ch10::MultigridStepper stale(scene, test::tight_solver(),
+                               ch10::multigrid_params<ch10::MultigridRecipe>(lagged));
   State a = rest_state(scene), b = rest_state(scene);
   const Eigen::VectorXd X = a.x;
   double motion = 0.0, difference = 0.0;
   for (int k = 0; k < 20; ++k) {
-    const Eigen::SparseMatrix<double> coarse = ch10::level_matrix(stale.multigrid(), 1);
+    const Eigen::SparseMatrix<double> coarse =
+        ch10::level_matrix(stale.preconditioner().multigrid(), 1);
     fresh.step(a);
     stale.step(b);
     CHECK(stale.profile().converged);
     // Between refreshes the coarse matrices are the old ones, to the bit.
-    if (k > 0 && !stale.multigrid().refresh_rule().refreshed())
-      CHECK((ch10::level_matrix(stale.multigrid(), 1) - coarse).norm() == 0.0);
+    if (k > 0 && !stale.preconditioner().multigrid().refresh_rule().refreshed())
+      CHECK((ch10::level_matrix(stale.preconditioner().multigrid(), 1) - coarse).norm() == 0.0);
     motion = std::max(motion, (a.x - X).cwiseAbs().maxCoeff());
     difference = std::max(difference, (a.x - b.x).cwiseAbs().maxCoeff());
   }
-  CHECK(fresh.multigrid().refresh_rule().refreshes() == 20);
-  CHECK(stale.multigrid().refresh_rule().refreshes() == 4);  // steps 1, 6, 11 and 16
+  CHECK(fresh.preconditioner().multigrid().refresh_rule().refreshes() == 20);
+  CHECK(stale.preconditioner().multigrid().refresh_rule().refreshes() ==
+        4);  // steps 1, 6, 11 and 16
   INFO("max |dx| " << difference << " of motion " << motion);
   CHECK(difference < 1e-8 * motion);
   // The last step (the 20th) kept the coarse matrices of the 16th: still SPD.
   for (const Smoother smoother : kSmoothers) {
     lagged.multigrid.relax.smoother = smoother;
-    ch10::MultigridStepper stepper(scene, {}, lagged);
+    ch10::MultigridStepper stepper(scene, {},
+                                   ch10::multigrid_params<ch10::MultigridRecipe>(lagged));
     State state = rest_state(scene);
     for (int k = 0; k < 8; ++k) stepper.step(state);
-    REQUIRE(!stepper.multigrid().refresh_rule().refreshed());
+    REQUIRE(!stepper.preconditioner().multigrid().refresh_rule().refreshed());
     std::srand(11);
     const Eigen::Index n = X.size();
     const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
     Eigen::VectorXd Mx(n), My(n);
-    stepper.multigrid().apply(x, Mx);
-    stepper.multigrid().apply(y, My);
+    stepper.preconditioner().multigrid().apply(x, Mx);
+    stepper.preconditioner().multigrid().apply(y, My);
     INFO("smoother " << static_cast<int>(smoother));
     CHECK(std::abs(x.dot(My) - y.dot(Mx)) <= 1e-12 * std::sqrt(x.dot(Mx) * y.dot(My)));
     CHECK(x.dot(Mx) > 0.0);
@@ -308,17 +319,17 @@ struct Soak {
 Soak soak(const Scene& scene, int threads, int steps) {
   const ThreadCountScope scope(threads);
   ch10::MultigridStepper stepper(scene, {});
-  stepper.adaptive_team().set_enabled(false);
+  stepper.team().adaptive_team().set_enabled(false);
   test::JumpingMouse mouse(scene, 50);
   Soak out;
   out.state = rest_state(scene);
   out.diverged = test::soak_under_mouse(stepper, mouse, out.state, steps, [&](int k) {
     out.not_converged += stepper.profile().converged ? 0 : 1;
     out.most_iterations = std::max(out.most_iterations, stepper.profile().cg_iterations);
-    if (mouse.just_jumped(k, 3) && stepper.multigrid().refresh_rule().refreshed())
+    if (mouse.just_jumped(k, 3) && stepper.preconditioner().multigrid().refresh_rule().refreshed())
       ++out.jump_refreshes;
   });
-  out.refreshes = stepper.multigrid().refresh_rule().refreshes();
+  out.refreshes = stepper.preconditioner().multigrid().refresh_rule().refreshes();
   return out;
 }
 

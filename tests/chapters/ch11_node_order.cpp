@@ -98,9 +98,11 @@ TEST_CASE("ch11: the renumbered scene is the same scene under another naming", "
 TEST_CASE("ch11: with the identity order, chapter 11 is chapter 10 to the last bit", "[ch11]") {
   const Scene scene = test::driven_scene();
   ch10::MultigridStepper ten(scene, {});
-  ch11::NodeOrderStepper eleven(scene, {}, ch11::Ordering::original);
-  ten.adaptive_team().set_enabled(false);
-  eleven.adaptive_team().set_enabled(false);
+  ch11::NodeOrderStepper::Params original;
+  original.order.ordering = ch11::Ordering::original;
+  ch11::NodeOrderStepper eleven(scene, {}, original);
+  ten.team().adaptive_team().set_enabled(false);
+  eleven.team().adaptive_team().set_enabled(false);
   State a = rest_state(scene), b = rest_state(scene);
   for (int k = 0; k < 30; ++k) {
     ten.step(a);
@@ -150,9 +152,10 @@ TEST_CASE("ch11: the elements along the mesh form slabs that need few colours", 
   const Scene scene = make_scene("cantilever", load_mesh(test::mesh_path("plate_poster.msh")));
   const ch11::NodeOrderStepper eleven(scene, {});
   const ch10::MultigridStepper ten(scene, {});
-  INFO("colours: chapter 10 " << ten.colours() << ", chapter 11 " << eleven.colours());
-  CHECK(eleven.colours() <= 8);
-  CHECK(4 * eleven.colours() < ten.colours());
+  INFO("colours: chapter 10 " << ten.elements().colours() << ", chapter 11 "
+                              << eleven.elements().colours());
+  CHECK(eleven.elements().colours() <= 8);
+  CHECK(4 * eleven.elements().colours() < ten.elements().colours());
 }
 
 TEST_CASE("ch11: zero heap allocations per step after the first, with 2 threads", "[ch11]") {

@@ -24,6 +24,11 @@ FEM_CHAPTER_TESTS("12", "[ch12]")
 
 namespace {
 
+// Chapter 12's recipe with its float numbers widened to double in registers.
+struct Widened : ch12::HalfTheBytes {
+  using Preconditioner = ch12::ReducedMultigrid<double>;
+};
+
 Eigen::VectorXd filtered_random(const Scene& scene, Eigen::Index size) {
   Eigen::VectorXd v = Eigen::VectorXd::Random(size);
   for (const auto& c : scene.constraints)
@@ -43,11 +48,12 @@ ch10::MultigridStepperSettings three_levels() {
 // smallest x^T M x / x^T x.
 template <class Real>
 std::pair<double, double> asymmetry_and_positivity(const Scene& scene) {
-  ch10::MultigridStepper stepper(scene, {}, three_levels());
+  ch10::MultigridStepper stepper(scene, {},
+                                 ch10::multigrid_params<ch10::MultigridRecipe>(three_levels()));
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
-  REQUIRE(stepper.multigrid().levels() == 3);
-  ch12::ReducedVCycle<Real> v_cycle(stepper.multigrid());
+  REQUIRE(stepper.preconditioner().multigrid().levels() == 3);
+  ch12::ReducedVCycle<Real> v_cycle(stepper.preconditioner().multigrid());
   v_cycle.prepare(stepper.system_matrix(), ch09::RowChunks{});
   std::srand(12);
   const Eigen::Index n = stepper.system_rhs().size();
@@ -84,16 +90,17 @@ TEST_CASE("ch12: the float V-cycle is symmetric to its rounding and positive def
 
 TEST_CASE("ch12: the float numbers are chapter 10's rounded, and half their bytes", "[ch12]") {
   const Scene scene = test::test_scene("cantilever");
-  ch10::MultigridStepper stepper(scene, {}, three_levels());
+  ch10::MultigridStepper stepper(scene, {},
+                                 ch10::multigrid_params<ch10::MultigridRecipe>(three_levels()));
   State state = rest_state(scene);
   stepper.step(state);
-  ch12::ReducedVCycle<float> single(stepper.multigrid());
-  ch12::ReducedVCycle<double> widened(stepper.multigrid());
+  ch12::ReducedVCycle<float> single(stepper.preconditioner().multigrid());
+  ch12::ReducedVCycle<double> widened(stepper.preconditioner().multigrid());
   single.prepare(stepper.system_matrix(), ch09::RowChunks{});
   widened.prepare(stepper.system_matrix(), ch09::RowChunks{});
   CHECK(single.number_bytes() == widened.number_bytes());
   // Chapter 10's hierarchy in double: blocks, prolongators both ways, inverse diagonals.
-  const ch10::Multigrid& mg = stepper.multigrid();
+  const ch10::Multigrid& mg = stepper.preconditioner().multigrid();
   long long double_bytes = 0;
   for (int l = 0; l < mg.levels() - 1; ++l) {
     const int b = l == 0 ? 3 : ch10::kModes;
@@ -113,7 +120,7 @@ TEST_CASE("ch12: at most one iteration more than chapter 11 at 1e-4, and 1e-10 s
       settings.tolerance = tolerance;
       ch11::NodeOrderStepper reference(scene, settings);
       ch12::HalfBytesStepper single(scene, settings);
-      ch12::HalfBytesStepper widened(scene, settings, ch12::Arithmetic::double_on_float);
+      ch08::StepOf<Widened> widened(scene, settings);
       State a = rest_state(scene), b = a, c = a;
       int worst = 0;
       for (int k = 0; k < 20; ++k) {
@@ -135,9 +142,9 @@ TEST_CASE("ch12: at most one iteration more than chapter 11 at 1e-4, and 1e-10 s
 TEST_CASE("ch12: refuses chapter 10's Gauss-Seidel smoother", "[ch12]") {
   ch10::MultigridStepperSettings s;
   s.multigrid.relax.smoother = ch10::Smoother::GaussSeidel;
-  CHECK_THROWS_AS(
-      ch12::HalfBytesStepper(test::test_scene("cantilever"), {}, ch12::Arithmetic::single, s),
-      std::invalid_argument);
+  CHECK_THROWS_AS(ch12::HalfBytesStepper(test::test_scene("cantilever"), {},
+                                         ch10::multigrid_params<ch12::HalfTheBytes>(s)),
+                  std::invalid_argument);
 }
 
 TEST_CASE("ch12: zero heap allocations per step after the first, with 2 threads", "[ch12]") {

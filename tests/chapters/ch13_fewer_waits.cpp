@@ -45,11 +45,11 @@ ch10::MultigridStepperSettings three_levels(bool serial) {
 // `threads` threads, both applied inside one team as the PCG applies them.
 double fused_against_chapter_12(const Scene& scene, int threads,
                                 const ch10::MultigridStepperSettings& multigrid) {
-  ch12::HalfBytesStepper stepper(scene, {}, ch12::Arithmetic::single, multigrid);
+  ch12::HalfBytesStepper stepper(scene, {}, ch10::multigrid_params<ch12::HalfTheBytes>(multigrid));
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
-  auto& reduced = dynamic_cast<ch12::ReducedVCycle<float>&>(stepper.v_cycle());
-  ch13::FusedVCycle fused(reduced, stepper.multigrid());
+  auto& reduced = stepper.preconditioner().v_cycle();
+  ch13::FusedVCycle fused(reduced, stepper.preconditioner().multigrid());
   const ThreadCountScope scope(threads);
   const Eigen::Index n = stepper.system_rhs().size();
   std::mt19937 rng(13);
@@ -72,8 +72,8 @@ double fused_against_chapter_12(const Scene& scene, int threads,
 State run_13(const Scene& scene, int threads, int steps, const ch10::MultigridStepperSettings& mg,
              const SolverSettings& settings = {}) {
   const ThreadCountScope scope(threads);
-  ch13::FewerWaitsStepper stepper(scene, settings, mg);
-  stepper.adaptive_team().set_enabled(false);  // really this many threads, every step
+  ch13::FewerWaitsStepper stepper(scene, settings, ch10::multigrid_params<ch13::FewerWaits>(mg));
+  stepper.team().adaptive_team().set_enabled(false);  // really this many threads, every step
   State state = rest_state(scene);
   for (int k = 0; k < steps; ++k) {
     stepper.step(state);
@@ -89,9 +89,10 @@ TEST_CASE("ch13: the fused V-cycle is chapter 12's to the bit, on every path and
   const Scene scene = test::test_scene("cantilever");
   for (const bool serial : {false, true}) {
     // The hierarchy really has a middle level (shared, or serial) above the coarsest.
-    ch12::HalfBytesStepper probe(scene, {}, ch12::Arithmetic::single, three_levels(serial));
-    REQUIRE(probe.multigrid().levels() == 3);
-    const auto& middle = probe.multigrid().coarse_levels()[0];
+    ch12::HalfBytesStepper probe(scene, {},
+                                 ch10::multigrid_params<ch12::HalfTheBytes>(three_levels(serial)));
+    REQUIRE(probe.preconditioner().multigrid().levels() == 3);
+    const auto& middle = probe.preconditioner().multigrid().coarse_levels()[0];
     REQUIRE(middle.rows.serial == serial);
     REQUIRE((serial || middle.rows.count() > 1));
     for (const int threads : thread_counts()) {
@@ -128,7 +129,7 @@ StepWaits waits_of_step(const Scene& scene, Make&& make, int iterations) {
   settings.tolerance = 1e-14;
   settings.max_iterations = iterations;
   const auto stepper = make(settings);
-  stepper->adaptive_team().set_enabled(false);
+  stepper->team().adaptive_team().set_enabled(false);
   State state = rest_state(scene);
   const long long seen = barriers_during([&] { stepper->step(state); });
   REQUIRE(stepper->profile().cg_iterations == iterations);
@@ -156,14 +157,14 @@ TEST_CASE("ch13: the waits counted, per V-cycle and per PCG iteration, against c
   const ThreadCountScope scope(openmp_enabled() ? 2 : 1);
   // Three levels, the finest and the middle one shared by the team: every path of the fusion.
   const ch10::MultigridStepperSettings mg = three_levels(false);
-  ch12::HalfBytesStepper stepper(scene, {}, ch12::Arithmetic::single, mg);
+  ch12::HalfBytesStepper stepper(scene, {}, ch10::multigrid_params<ch12::HalfTheBytes>(mg));
   State state = rest_state(scene);
   stepper.step(state);
-  REQUIRE(stepper.multigrid().levels() == 3);
-  REQUIRE(!stepper.multigrid().fine_level().rows.serial);
-  REQUIRE(!stepper.multigrid().coarse_levels()[0].rows.serial);
-  auto& reduced = dynamic_cast<ch12::ReducedVCycle<float>&>(stepper.v_cycle());
-  ch13::FusedVCycle fused(reduced, stepper.multigrid());
+  REQUIRE(stepper.preconditioner().multigrid().levels() == 3);
+  REQUIRE(!stepper.preconditioner().multigrid().fine_level().rows.serial);
+  REQUIRE(!stepper.preconditioner().multigrid().coarse_levels()[0].rows.serial);
+  auto& reduced = stepper.preconditioner().v_cycle();
+  ch13::FusedVCycle fused(reduced, stepper.preconditioner().multigrid());
   const Eigen::VectorXd r = Eigen::VectorXd::Ones(stepper.system_rhs().size());
   Eigen::VectorXd s(r.size());
   ch09::run_parallel([&] { fused.prepare(stepper.system_matrix(), ch09::RowChunks{}); });
@@ -177,11 +178,12 @@ TEST_CASE("ch13: the waits counted, per V-cycle and per PCG iteration, against c
   CHECK(twelve == 2 * (2 * steps + 3) + 1 + 2);  // 21
   CHECK(thirteen == twelve - 4);                 // 17
   CHECK(waits_per_iteration(scene, [&](const SolverSettings& settings) {
-          return std::make_unique<ch13::FewerWaitsStepper>(scene, settings, mg);
+          return std::make_unique<ch13::FewerWaitsStepper>(
+              scene, settings, ch10::multigrid_params<ch13::FewerWaits>(mg));
         }) == thirteen + 1);  // 18
   CHECK(waits_per_iteration(scene, [&](const SolverSettings& settings) {
-          return std::make_unique<ch12::HalfBytesStepper>(scene, settings, ch12::Arithmetic::single,
-                                                          mg);
+          return std::make_unique<ch12::HalfBytesStepper>(
+              scene, settings, ch10::multigrid_params<ch12::HalfTheBytes>(mg));
         }) == twelve + 4);  // 25
 }
 
@@ -195,7 +197,8 @@ TEST_CASE("ch13: the solve phase counts its iterations' waits: iterations x the 
   const ThreadCountScope scope(openmp_enabled() ? 2 : 1);
   const ch10::MultigridStepperSettings mg = three_levels(false);
   const auto make = [&](const SolverSettings& settings) {
-    return std::make_unique<ch13::FewerWaitsStepper>(scene, settings, mg);
+    return std::make_unique<ch13::FewerWaitsStepper>(scene, settings,
+                                                     ch10::multigrid_params<ch13::FewerWaits>(mg));
   };
   const long long per_iteration = waits_per_iteration(scene, make);
   REQUIRE(per_iteration > 0);  // 18: checked against the theory in the test above
@@ -271,7 +274,7 @@ struct Soak {
 Soak soak(const Scene& scene, int threads, int steps) {
   const ThreadCountScope scope(threads);
   ch13::FewerWaitsStepper stepper(scene, {});
-  stepper.adaptive_team().set_enabled(false);
+  stepper.team().adaptive_team().set_enabled(false);
   test::JumpingMouse mouse(scene, 7);
   Soak out;
   out.state = rest_state(scene);

@@ -10,11 +10,16 @@
 #include "apps/roofline/placement.hpp"
 #include "catch2_compat.hpp"
 #include "chapters/01_naive/work.hpp"
+#include "chapters/07_block_sparse/stepper.hpp"
 #include "chapters/07_block_sparse/work.hpp"
+#include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/08_element_kernels/work.hpp"
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/report.hpp"
+#include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/10_multigrid/work.hpp"
+#include "chapters/11_node_order/stepper.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/12_half_the_bytes/work.hpp"
 #include "chapters/registry.hpp"
 #include "common/threads.hpp"
@@ -53,16 +58,15 @@ std::vector<PhaseWork> stepped_work(const ChapterInfo& chapter, Stepper& stepper
 TEST_CASE("roofline: chapter 07's matrix bytes are its blocks and indices", "[roofline]") {
   const Scene scene = test::test_scene("cantilever");
   const ChapterInfo& chapter = find_chapter("07");
-  const auto stepper = chapter.make(scene, {});
-  const auto work = stepped_work(chapter, *stepper, scene, 1);
-  const auto& A =
-      dynamic_cast<const ch07::BlockSparseStepper&>(unwrapped(*stepper)).system_matrix();
+  ch07::BlockSparseStepper stepper(scene, {});
+  const auto work = stepped_work(chapter, stepper, scene, 1);
+  const auto& A = stepper.system_matrix();
   const double expected =
       double(A.blocks.size()) * 72.0 + double(A.column.size() + A.row_start.size()) * 4.0;
   CHECK(ch07::matrix_bytes(A) == expected);
   // The solve: per product the matrix and the block-Jacobi inverses read; 8 vectors read, 5
   // written, 2 of them (q and z) to lines not read first.
-  const double it = stepper->profile().cg_iterations;
+  const double it = stepper.profile().cg_iterations;
   const double v = 3.0 * scene.mesh.num_nodes() * 8;
   const double read = expected + scene.mesh.num_nodes() * 72.0 + 8 * v;
   CHECK(phase(work, "solve").bytes_read == Approx((it + 1) * read));
@@ -99,13 +103,12 @@ TEST_CASE("roofline: chapter 01's matrix bytes are Eigen's compressed storage", 
 TEST_CASE("roofline: the fused pass's writes are the objects it writes", "[roofline]") {
   const Scene scene = test::test_scene("cantilever");
   const ChapterInfo& chapter = find_chapter("08");
-  const auto stepper = chapter.make(scene, {});
-  const auto work = stepped_work(chapter, *stepper, scene, 2);
-  const auto& s = dynamic_cast<const ch08::ElementKernelsStepper&>(unwrapped(*stepper));
+  ch08::ElementKernelsStepper s(scene, {});
+  const auto work = stepped_work(chapter, s, scene, 2);
   // Both rotations of every element, every block of A and b: their sizes in memory.
   const double rotations =
-      double(s.elements().rotations().size()) * sizeof(Eigen::Quaterniond) +
-      double(s.elements().previous_rotations().size()) * sizeof(Eigen::Quaterniond);
+      double(s.elements().fused().rotations().size()) * sizeof(Eigen::Quaterniond) +
+      double(s.elements().fused().previous_rotations().size()) * sizeof(Eigen::Quaterniond);
   const double A = double(s.system_matrix().blocks.size()) * sizeof(Eigen::Matrix3d);
   const double b = double(s.system_rhs().size()) * sizeof(double);
   CHECK(phase(work, "forces").bytes_written == Approx(rotations + A + b));
@@ -147,11 +150,12 @@ TEST_CASE("roofline: a chapter is counted from its own data, not its base's", "[
   const Scene scene = test::test_scene("cantilever");
   const ChapterInfo& c11 = find_chapter("11");
   const ChapterInfo& c12 = find_chapter("12");
-  const auto s11 = c11.make(scene, {}), s12 = c12.make(scene, {});
+  auto s11 = std::make_unique<ch11::NodeOrderStepper>(scene, SolverSettings{});
+  auto s12 = std::make_unique<ch12::HalfBytesStepper>(scene, SolverSettings{});
   const auto w11 = stepped_work(c11, *s11, scene, 1);
   const auto w12 = stepped_work(c12, *s12, scene, 1);
-  const auto& m11 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s11)).multigrid();
-  const auto& m12 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s12)).multigrid();
+  const auto& m11 = s11->preconditioner().multigrid();
+  const auto& m12 = s12->preconditioner().multigrid();
   const auto v11 =
       ch10::v_cycle_work(ch10::multigrid_levels(m11), ch10::smoother_products(m11), 8, false);
   const auto v12 =
@@ -169,20 +173,21 @@ TEST_CASE("roofline: the V-cycle's levels are the hierarchy's matrices", "[roofl
   ch10::MultigridStepper stepper(scene, {});
   State state = rest_state(scene);
   stepper.step(state);
-  const auto levels = ch10::multigrid_levels(stepper.multigrid());
-  REQUIRE(int(levels.size()) == stepper.multigrid().levels());
+  const auto levels = ch10::multigrid_levels(stepper.preconditioner().multigrid());
+  REQUIRE(int(levels.size()) == stepper.preconditioner().multigrid().levels());
   CHECK(levels.back().coarsest);
   for (std::size_t l = 0; l < levels.size(); ++l) {
-    const auto A = ch10::level_matrix(stepper.multigrid(), int(l));  // an independent conversion
+    const auto A = ch10::level_matrix(stepper.preconditioner().multigrid(),
+                                      int(l));  // an independent conversion
     const int b = levels[l].block;
     CHECK(double(levels[l].nodes * b) == double(A.rows()));
     CHECK(double(levels[l].blocks) * b * b >= double(A.nonZeros()));  // zero entries not stored
     if (!levels[l].coarsest)
       CHECK(double(levels[l].transfer) * b * ch10::kModes >=
-            double(ch10::prolongator(stepper.multigrid(), int(l)).nonZeros()));
+            double(ch10::prolongator(stepper.preconditioner().multigrid(), int(l)).nonZeros()));
   }
   // A float V-cycle streams fewer bytes than a double one over the same levels.
-  const int products = ch10::smoother_products(stepper.multigrid());
+  const int products = ch10::smoother_products(stepper.preconditioner().multigrid());
   CHECK(products >= 2);
   CHECK(ch10::v_cycle_work(levels, products, 4, true).bytes() <
         ch10::v_cycle_work(levels, products, 8, false).bytes());
@@ -235,7 +240,7 @@ TEST_CASE("roofline: the V-cycle is counted per level, each part on its own data
   ch10::MultigridStepper stepper(scene, {});
   State state = rest_state(scene);
   stepper.step(state);
-  const ch10::Multigrid& mg = stepper.multigrid();
+  const ch10::Multigrid& mg = stepper.preconditioner().multigrid();
   REQUIRE(mg.levels() >= 2);
   const int products = ch10::smoother_products(mg);
   for (const int scalar : {8, 4}) {
@@ -263,11 +268,11 @@ TEST_CASE("roofline: the V-cycle is counted per level, each part on its own data
   }
   // In the chapter's solve, every V-cycle part runs once per PCG pass, beside the PCG's own.
   const ChapterInfo& c10 = find_chapter("10");
-  const auto s10 = c10.make(scene, {});
+  auto s10 = std::make_unique<ch10::MultigridStepper>(scene, SolverSettings{});
   const auto work = stepped_work(c10, *s10, scene, 1);
   const PhaseWork& solve = phase(work, "solve");
   const double passes = s10->profile().cg_iterations + 1.0;
-  const auto& m10 = dynamic_cast<const ch10::MultigridStepper&>(unwrapped(*s10)).multigrid();
+  const auto& m10 = s10->preconditioner().multigrid();
   const PhaseWork v = ch10::v_cycle_work(ch10::multigrid_levels(m10), products, 8, false);
   const PhaseWork& fine = phase(solve.parts, "level 0 smoothing and residual");
   CHECK(fine.bytes_read == Approx(passes * phase(v.parts, fine.phase).bytes_read));

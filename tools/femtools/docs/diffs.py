@@ -7,9 +7,10 @@ stepper extends chapter 09's instead of copying it), as do the lesson measuremen
 text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
 header's path, "Chapter NN"), so that no hunk is a rename. It also writes the table of each
 chapter's files and what it includes from earlier chapters into chapters/README.md (between
-its chapter-files markers), and the table of which chapter's code runs each phase of each
-chapter's step (its phase-owners markers, docs/phase_owners.py). With --check, writes nothing and exits 1 if a committed diff or
-that table is stale or any hunk only changes names.
+its chapter-files markers; the table of which part runs each phase, between its phase-owners
+markers, is the program's: `fem_lessons phase-owners --write chapters/README.md`, from the
+steppers' recipes). With --check, writes nothing and exits 1 if a committed diff or the files
+table is stale or any hunk only changes names.
 
     fem-tools docs diffs                    # regenerate
     fem-tools docs diffs --check            # compare with the committed ones
@@ -22,9 +23,9 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.course import variant as make_variant
-from femtools.docs import phase_owners
 from femtools.docs.markers import replace_between
-STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b")
+STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b"
+                           r"|using\s+(\w+)\s*=\s*[\w:]*StepOf<")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
 
 
@@ -42,7 +43,7 @@ def names(chapter):
     namespace = re.search(r"namespace fem::(\w+) \{", (chapter / "stepper.hpp").read_text())
     return {"id": chapter.name, "number": chapter.name[:2],
             "namespace": namespace.group(1) if namespace else "",
-            "class": match.group(1) if match else ""}
+            "class": (match.group(1) or match.group(2)) if match else ""}
 
 
 def renamed(text, old, new, files=()):
@@ -212,18 +213,15 @@ def main(argv=None, prog=None):
     readme = args.root / "chapters" / "README.md"
     text = readme.read_text() if readme.exists() else ""
     new = with_files_table(text, files_table(dirs))
-    owners = phase_owners.owners_table(dirs, lambda chapter: names(chapter)["class"])
-    new = replace_between(new, phase_owners.MARKER, owners) if new is not None else None
     if new is None:
-        print(f"{readme}: no {FILES_MARKER} or {phase_owners.MARKER} markers", file=sys.stderr)
+        print(f"{readme}: no {FILES_MARKER} markers", file=sys.stderr)
         return 1
     if new != text:
         if args.check:
             stale.append(readme)
         else:
             readme.write_text(new)
-            print(f"wrote the {FILES_MARKER} and {phase_owners.MARKER} tables of "
-                  f"{readme.relative_to(args.root)}")
+            print(f"wrote the {FILES_MARKER} table of {readme.relative_to(args.root)}")
     if renames:
         print("hunks that only change names (normalise them in renamed()):\n  " + "\n  ".join(renames),
               file=sys.stderr)

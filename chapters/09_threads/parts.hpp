@@ -1,0 +1,77 @@
+// Chapter 09's other parts: the team a step runs on, block Jacobi on the fixed row chunks, and
+// the parallel PCG (parallel_pcg.hpp) that applies any chapter 09 Preconditioner.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/09_threads/adaptive_team.hpp"
+#include "chapters/09_threads/parallel_pcg.hpp"
+
+namespace fem::ch09 {
+
+// Team: OpenMP's threads (--threads, OMP_NUM_THREADS), or one thread while that is faster (a
+// busy machine: AdaptiveTeam). The state is the same either way.
+class TeamOfThreads {
+ public:
+  static constexpr const char* kName = "every thread, or one while that is faster";
+  static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
+  static constexpr bool kThreads = true;
+
+  TeamOfThreads();
+  template <class Step>
+  void run(Step&& step, const double& step_seconds) {
+    const int given = begin();
+    step();
+    end(given, step_seconds);
+  }
+  // Tests that compare thread counts keep the count they set (off); the environment variable
+  // FEM_ADAPTIVE_TEAM=0 turns it off for a whole program (to see what it prevents).
+  AdaptiveTeam& adaptive_team() { return adaptive_team_; }
+  const AdaptiveTeam& adaptive_team() const { return adaptive_team_; }
+
+ private:
+  int begin();  // sets this step's team; returns the program's count
+  void end(int given, double step_seconds);
+
+  AdaptiveTeam adaptive_team_;
+  long long steps_taken_ = 0;
+  int team_ = 0;
+};
+
+// Preconditioner: block Jacobi, s_i = D_i^-1 r_i, chunk by chunk inside the PCG's loops.
+class JacobiOnChunks {
+ public:
+  struct Params {};
+  static constexpr const char* kName = "block Jacobi on the row chunks";
+  static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
+
+  JacobiOnChunks(const ch08::PartSetup& setup, const Params&)
+      : jacobi_(setup.system.index.diagonal) {}
+  Preconditioner& pcg_preconditioner() { return jacobi_; }
+
+ private:
+  BlockJacobi jacobi_;
+};
+
+// Solver: the parallel PCG with the recipe's preconditioner.
+class ParallelPcgSolver {
+ public:
+  static constexpr const char* kName = "parallel PCG, three barriers an iteration";
+  static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
+
+  template <class Part>
+  ParallelPcgSolver(const ch08::PartSetup& setup, Part&)
+      : pcg_(setup.system.A, setup.scene.constraints) {}
+  template <class Part>
+  SolveStats solve(ch08::System& system, Part& preconditioner, const SolverSettings& settings) {
+    return pcg_.solve(system.A, preconditioner.pcg_preconditioner(), system.filtered_b, settings,
+                      system.y);
+  }
+  ParallelPcg& pcg() { return pcg_; }
+
+ private:
+  ParallelPcg pcg_;
+};
+
+}  // namespace fem::ch09
