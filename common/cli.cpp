@@ -167,6 +167,9 @@ void add_scene_options(ArgParser& args, const std::string& default_mesh) {
 
 std::string resolve_mesh_path(const std::string& path) {
   namespace fs = std::filesystem;
+  // An empty path stays empty (load_mesh refuses it): joined to the source folder it named
+  // the folder itself.
+  if (path.empty()) return path;
   if (fs::path(path).is_relative() && !fs::exists(path) &&
       fs::exists(fs::path(source_dir()) / path))
     return (fs::path(source_dir()) / path).string();

@@ -1,0 +1,285 @@
+#include "common/msh_check.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "common/mesh.hpp"
+
+namespace fem {
+namespace {
+
+using Count = std::uint64_t;
+
+// The fewest bytes a record takes in an ASCII file, by which a header's count is checked
+// against the bytes left: a node is "1 0 0 0\n" (MSH 2.2) or "1\n" and "0 0 0\n" (MSH 4.1), an
+// element at least "1 1\n", an entity or a block header at least "0 1 0 0\n".
+constexpr Count kNodeBytes = 8, kElementBytes = 4, kHeaderBytes = 8;
+
+[[noreturn]] void fail_file(const std::string& file, const std::string& problem) {
+  throw MeshError("mesh '" + file + "': " + problem);
+}
+
+// Reads the file line by line, counting the bytes read so that a header's count can be held
+// against the bytes left, and the lines, so that a message can point into the file.
+class MshReader {
+ public:
+  MshReader(const std::string& path, Count size) : path_(path), size_(size), in_(path) {
+    if (!in_) fail("cannot open the file (missing or unreadable)");
+  }
+
+  // The next line without its line end ("\r\n" too), or false at the end of the file.
+  bool next(std::string& line) {
+    if (!std::getline(in_, line)) return false;
+    read_ += line.size() + 1;
+    ++line_number_;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  }
+
+  Count bytes_left() const { return read_ < size_ ? size_ - read_ : 0; }
+  [[noreturn]] void fail(const std::string& problem) const { fail_file(path_, problem); }
+  std::string at() const { return "line " + std::to_string(line_number_); }
+
+ private:
+  std::string path_;
+  Count size_, read_ = 0, line_number_ = 0;
+  std::ifstream in_;
+};
+
+// A section's records as its header declares them, for the messages of a cut or short section.
+struct Records {
+  std::string section;  // "Nodes"
+  std::string noun;     // "nodes"
+  Count declared = 0;
+};
+
+// The next record line of a section: the file's end or a '$' line there means the section
+// holds fewer records than its header declares.
+void next_record(MshReader& r, const Records& s, Count done, std::string& line) {
+  const std::string progress =
+      std::to_string(done) + " of its " + std::to_string(s.declared) + " " + s.noun + ")";
+  if (!r.next(line)) r.fail("the file ends inside section $" + s.section + " (after " + progress);
+  if (!line.empty() && line[0] == '$')
+    r.fail(r.at() + ": section $" + s.section + " ends early (" + line + " after " + progress);
+}
+
+// The first n whitespace-separated integers of a line, or a message naming the line.
+template <std::size_t n>
+std::array<std::int64_t, n> integers(const MshReader& r, const std::string& line,
+                                     const std::string& what) {
+  std::array<std::int64_t, n> out{};
+  const char* p = line.data();
+  const char* const end = p + line.size();
+  for (auto& value : out) {
+    while (p < end && (*p == ' ' || *p == '\t')) ++p;
+    const auto [next, error] = std::from_chars(p, end, value);
+    // The whole word is the number: "1e9" is not the count 1.
+    const bool whole = next == end || *next == ' ' || *next == '\t';
+    if (error != std::errc() || !whole) r.fail(r.at() + ": '" + line + "' is not " + what);
+    p = next;
+  }
+  return out;
+}
+
+// A count from a header, refused when negative or when the bytes left cannot hold that many
+// records: checked before anything is sized by it.
+Count checked_count(const MshReader& r, std::int64_t count, const Records& s, Count min_bytes) {
+  if (count < 0) r.fail(r.at() + ": section $" + s.section + " declares a negative count");
+  const Count fits = r.bytes_left() / min_bytes;
+  if (static_cast<Count>(count) > fits)
+    r.fail("its $" + s.section + " section declares " + std::to_string(count) + " " + s.noun +
+           ", more than the file can hold (" + std::to_string(r.bytes_left()) +
+           " bytes follow the count: room for at most " + std::to_string(fits) + " at " +
+           std::to_string(min_bytes) + " bytes each): the file ends inside section $" + s.section +
+           ", or the header is corrupt");
+  return static_cast<Count>(count);
+}
+
+void expect_end(MshReader& r, const std::string& section) {
+  std::string line;
+  if (!r.next(line))
+    r.fail("the file ends inside section $" + section + " (no $End" + section + ")");
+  if (line != "$End" + section)
+    r.fail(r.at() + ": '" + line + "' where $End" + section +
+           " should close the section: it holds more than its header declares");
+}
+
+// Skips a section this check does not read, up to its end line.
+void skip_section(MshReader& r, const std::string& section) {
+  std::string line;
+  while (r.next(line))
+    if (line == "$End" + section) return;
+  r.fail("the file ends inside section $" + section + " (no $End" + section + ")");
+}
+
+// A section's header line of n counts.
+template <std::size_t n>
+std::array<std::int64_t, n> header(MshReader& r, const std::string& section) {
+  std::string line;
+  if (!r.next(line)) r.fail("the file ends inside section $" + section + " (before its header)");
+  return integers<n>(r, line, "the section's header (" + std::to_string(n) + " integers)");
+}
+
+void scan_nodes_22(MshReader& r, std::vector<Count>& tags) {
+  Records s{"Nodes", "nodes", 0};
+  s.declared = checked_count(r, header<1>(r, s.section)[0], s, kNodeBytes);
+  tags.reserve(s.declared);
+  std::string line;
+  for (Count i = 0; i < s.declared; ++i) {
+    next_record(r, s, i, line);
+    tags.push_back(static_cast<Count>(integers<1>(r, line, "a node (tag x y z)")[0]));
+  }
+  expect_end(r, "Nodes");
+}
+
+// One entity block of MSH 4.1's $Nodes: its tags, one a line, then as many coordinate lines.
+void scan_node_block_41(MshReader& r, const Records& s, std::vector<Count>& tags) {
+  std::string line;
+  next_record(r, s, tags.size(), line);
+  const Count left = s.declared - tags.size();
+  const auto block = integers<4>(r, line, "a node block's header (dim tag parametric count)");
+  if (block[3] < 0 || static_cast<Count>(block[3]) > left)
+    r.fail(r.at() + ": a node block of " + std::to_string(block[3]) + " nodes where the header's " +
+           std::to_string(s.declared) + " leave " + std::to_string(left));
+  const Count done = tags.size(), in_block = static_cast<Count>(block[3]);
+  for (Count i = 0; i < in_block; ++i) {
+    next_record(r, s, done + i, line);
+    tags.push_back(static_cast<Count>(integers<1>(r, line, "a node tag")[0]));
+  }
+  for (Count i = 0; i < in_block; ++i) next_record(r, s, done + i, line);
+}
+
+void scan_nodes_41(MshReader& r, std::vector<Count>& tags) {
+  Records s{"Nodes", "nodes", 0};
+  const auto head = header<4>(r, s.section);
+  const Count blocks = checked_count(r, head[0], {"Nodes", "entity blocks"}, kHeaderBytes);
+  s.declared = checked_count(r, head[1], s, kNodeBytes);
+  tags.reserve(s.declared);
+  for (Count b = 0; b < blocks; ++b) scan_node_block_41(r, s, tags);
+  if (tags.size() != s.declared)
+    r.fail("its $Nodes section declares " + std::to_string(s.declared) +
+           " nodes and its blocks "
+           "hold " +
+           std::to_string(tags.size()));
+  expect_end(r, "Nodes");
+}
+
+void scan_elements_22(MshReader& r) {
+  Records s{"Elements", "elements", 0};
+  s.declared = checked_count(r, header<1>(r, s.section)[0], s, kElementBytes);
+  std::string line;
+  for (Count i = 0; i < s.declared; ++i) next_record(r, s, i, line);
+  expect_end(r, "Elements");
+}
+
+void scan_elements_41(MshReader& r) {
+  Records s{"Elements", "elements", 0};
+  const auto head = header<4>(r, s.section);
+  const Count blocks = checked_count(r, head[0], {"Elements", "entity blocks"}, kHeaderBytes);
+  s.declared = checked_count(r, head[1], s, kElementBytes);
+  Count done = 0;
+  std::string line;
+  for (Count b = 0; b < blocks; ++b) {
+    next_record(r, s, done, line);
+    const auto block = integers<4>(r, line, "an element block's header (dim tag type count)");
+    if (block[3] < 0 || static_cast<Count>(block[3]) > s.declared - done)
+      r.fail(r.at() + ": an element block of " + std::to_string(block[3]) +
+             " elements where the header's " + std::to_string(s.declared) + " leave " +
+             std::to_string(s.declared - done));
+    const Count end = done + static_cast<Count>(block[3]);
+    for (; done < end; ++done) next_record(r, s, done, line);
+  }
+  expect_end(r, "Elements");
+}
+
+// MSH 4.1's $Entities: the four counts held against the file's size (gmsh reads that many).
+void scan_entities_41(MshReader& r) {
+  const Records s{"Entities", "entities", 0};
+  for (const std::int64_t count : header<4>(r, s.section)) checked_count(r, count, s, kHeaderBytes);
+  skip_section(r, "Entities");
+}
+
+// The version from $MeshFormat: 2 (2.x) or 4 (4.1), ASCII only.
+int read_format(MshReader& r) {
+  std::string line;
+  if (!r.next(line) || line != "$MeshFormat")
+    r.fail("not a gmsh .msh file (its first line is not $MeshFormat)");
+  if (!r.next(line)) r.fail("the file ends inside section $MeshFormat");
+  const std::string version = line.substr(0, line.find(' '));
+  const auto words = line.substr(version.size());
+  const auto binary = integers<1>(r, words, "'version file-type data-size'")[0];
+  if (version.rfind("2.", 0) != 0 && version != "4.1")
+    r.fail("MSH version " + version +
+           ": the programs read MSH 4.1 and 2.2 (in gmsh: " + "Mesh.MshFileVersion = 4.1)");
+  if (binary != 0)
+    r.fail(
+        "a binary .msh file: the programs read ASCII files, whose counts they check before "
+        "reading (in gmsh: Mesh.Binary = 0)");
+  expect_end(r, "MeshFormat");
+  return version == "4.1" ? 4 : 2;
+}
+
+// The path names a regular file: an empty path, a directory or a device is refused by name.
+Count checked_file_size(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) fail_file(path, "an empty path names no file");
+  std::error_code error;
+  const auto status = fs::status(path, error);
+  if (!fs::exists(status)) fail_file(path, "cannot open the file (missing or unreadable)");
+  if (fs::is_directory(status)) fail_file(path, "is a directory, not a mesh file");
+  if (!fs::is_regular_file(status)) fail_file(path, "is not a regular file");
+  const Count size = fs::file_size(path);
+  if (size == 0) fail_file(path, "the file is empty");
+  return size;
+}
+
+void refuse_duplicate_tags(const MshReader& r, std::vector<Count>& tags) {
+  std::sort(tags.begin(), tags.end());
+  const auto twice = std::adjacent_find(tags.begin(), tags.end());
+  if (twice != tags.end())
+    r.fail("duplicate node tag " + std::to_string(*twice) +
+           ": the file defines that node twice (gmsh would keep the last and move the node)");
+}
+
+std::string missing_section(const std::string& section, const std::string& last) {
+  if (last.empty()) return "the file has no $" + section + " section";
+  return "the file ends after section $" + last + ", with no $" + section + " section";
+}
+
+}  // namespace
+
+void check_msh_file(const std::string& path) {
+  MshReader r(path, checked_file_size(path));
+  const int version = read_format(r);
+  std::vector<Count> tags;
+  bool nodes = false, elements = false;
+  std::string line, last = "MeshFormat";
+  while (r.next(line)) {
+    if (line.empty() || line[0] != '$') continue;  // gmsh skips lines between sections too
+    const std::string section = line.substr(1);
+    if (section.rfind("End", 0) == 0) r.fail(r.at() + ": " + line + " without its start");
+    if (section == "Nodes") {
+      if (nodes) r.fail(r.at() + ": a second $Nodes section");
+      version == 4 ? scan_nodes_41(r, tags) : scan_nodes_22(r, tags);
+      nodes = true;
+    } else if (section == "Elements") {
+      version == 4 ? scan_elements_41(r) : scan_elements_22(r);
+      elements = true;
+    } else if (section == "Entities" && version == 4) {
+      scan_entities_41(r);
+    } else {
+      skip_section(r, section);
+    }
+    last = section;
+  }
+  if (!nodes) r.fail(missing_section("Nodes", last));
+  if (!elements) r.fail(missing_section("Elements", last));
+  refuse_duplicate_tags(r, tags);
+}
+
+}  // namespace fem
