@@ -1,7 +1,9 @@
 #include "common/cli.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -101,9 +103,15 @@ const std::string& ArgParser::get(const std::string& name) const { return option
 
 double ArgParser::get_double(const std::string& name) const {
   const std::optional<double> v = parse_double(get(name));
-  if (!v || !std::isfinite(*v))
-    throw UsageError("--" + name + " expects a finite number, got '" + get(name) + "'");
-  return *v;
+  if (v && std::isfinite(*v)) return *v;
+  // A number too small or too large for a double (1e-320, 1e400) is a number: say so, rather
+  // than that it is not a finite one.
+  errno = 0;
+  const double magnitude = std::strtod(get(name).c_str(), nullptr);
+  if (!v && errno == ERANGE)
+    throw UsageError("--" + name + " " + get(name) + " is out of a double's range (" +
+                     (std::abs(magnitude) < 1.0 ? "below 2.2e-308" : "above 1.8e+308") + ")");
+  throw UsageError("--" + name + " expects a finite number, got '" + get(name) + "'");
 }
 
 int ArgParser::get_int(const std::string& name) const {
