@@ -285,19 +285,41 @@ int threads_from_args(const ArgParser& args) {
   return max_threads();
 }
 
-void write_between_markers(const std::string& path, const std::string& name,
-                           const std::string& text) {
+namespace {
+
+// The file's text and where the text between its markers <!-- NAME:begin/end --> starts and
+// ends; throws std::runtime_error naming what is missing.
+struct MarkedDoc {
+  std::string text;
+  std::size_t from = 0, to = 0;
+};
+
+MarkedDoc read_marked(const std::string& path, const std::string& name) {
+  if (std::filesystem::is_directory(path))
+    throw std::runtime_error("'" + path + "' is a directory, not a file with markers");
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read '" + path + "'");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  std::string doc = buffer.str();
+  MarkedDoc doc{buffer.str()};
   const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
-  const auto b = doc.find(begin), e = doc.find(end);
+  const auto b = doc.text.find(begin), e = doc.text.find(end);
   if (b == std::string::npos || e == std::string::npos || e < b)
     throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
-  doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
-  write_file_atomically(path, doc);
+  doc.from = b + begin.size();
+  doc.to = e;
+  return doc;
+}
+
+}  // namespace
+
+void check_markers(const std::string& path, const std::string& name) { read_marked(path, name); }
+
+void write_between_markers(const std::string& path, const std::string& name,
+                           const std::string& text) {
+  MarkedDoc doc = read_marked(path, name);
+  doc.text.replace(doc.from, doc.to - doc.from, "\n" + text);
+  write_file_atomically(path, doc.text);
 }
 
 void announce_long_run(const std::string& program, double seconds_per_step, long long steps) {
