@@ -41,6 +41,8 @@ class MshReader {
     return true;
   }
 
+  // Whether the last line had no line end: the file's last, cut inside a section.
+  bool at_cut_end() const { return in_.eof(); }
   Count bytes_left() const { return read_ < size_ ? size_ - read_ : 0; }
   [[noreturn]] void fail(const std::string& problem) const { fail_file(path_, problem); }
   std::string at() const { return "line " + std::to_string(line_number_); }
@@ -63,7 +65,8 @@ struct Records {
 void next_record(MshReader& r, const Records& s, Count done, std::string& line) {
   const std::string progress =
       std::to_string(done) + " of its " + std::to_string(s.declared) + " " + s.noun + ")";
-  if (!r.next(line)) r.fail("the file ends inside section $" + s.section + " (after " + progress);
+  if (!r.next(line) || r.at_cut_end())
+    r.fail("the file ends inside section $" + s.section + " (after " + progress);
   if (!line.empty() && line[0] == '$')
     r.fail(r.at() + ": section $" + s.section + " ends early (" + line + " after " + progress);
 }
@@ -84,6 +87,15 @@ std::array<std::int64_t, n> integers(const MshReader& r, const std::string& line
     p = next;
   }
   return out;
+}
+
+// Whether the line holds at least n whitespace-separated words (a node's tag and coordinates).
+bool has_words(const std::string& line, std::size_t n) {
+  std::size_t words = 0;
+  for (std::size_t i = 0; i < line.size() && words < n; ++i)
+    if (line[i] != ' ' && line[i] != '\t' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t'))
+      ++words;
+  return words >= n;
 }
 
 // A count from a header, refused when negative or when the bytes left cannot hold that many
@@ -132,6 +144,7 @@ void scan_nodes_22(MshReader& r, std::vector<Count>& tags) {
   std::string line;
   for (Count i = 0; i < s.declared; ++i) {
     next_record(r, s, i, line);
+    if (!has_words(line, 4)) r.fail(r.at() + ": '" + line + "' is not a node (tag x y z)");
     tags.push_back(static_cast<Count>(integers<1>(r, line, "a node (tag x y z)")[0]));
   }
   expect_end(r, "Nodes");
@@ -151,7 +164,10 @@ void scan_node_block_41(MshReader& r, const Records& s, std::vector<Count>& tags
     next_record(r, s, done + i, line);
     tags.push_back(static_cast<Count>(integers<1>(r, line, "a node tag")[0]));
   }
-  for (Count i = 0; i < in_block; ++i) next_record(r, s, done + i, line);
+  for (Count i = 0; i < in_block; ++i) {
+    next_record(r, s, done + i, line);
+    if (!has_words(line, 3)) r.fail(r.at() + ": '" + line + "' is not a node's x y z");
+  }
 }
 
 void scan_nodes_41(MshReader& r, std::vector<Count>& tags) {
@@ -268,6 +284,9 @@ void check_msh_file(const std::string& path) {
       version == 4 ? scan_nodes_41(r, tags) : scan_nodes_22(r, tags);
       nodes = true;
     } else if (section == "Elements") {
+      // A second one adds its elements to the first's (gmsh reads both): a body stiffer and
+      // heavier than the file's first section says.
+      if (elements) r.fail(r.at() + ": a second $Elements section");
       version == 4 ? scan_elements_41(r) : scan_elements_22(r);
       elements = true;
     } else if (section == "Entities" && version == 4) {

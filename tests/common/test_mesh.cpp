@@ -244,6 +244,26 @@ TEST_CASE("a cut file is refused naming the section it ends inside or after", "[
                     contains_text("the file ends inside section $Nodes (after "));
 }
 
+TEST_CASE("a node without its coordinates, a second $Elements section are refused", "[mesh]") {
+  std::string no_z = cube22();
+  no_z.replace(no_z.find("\n3 0 1 0\n"), 9, "\n3 0 1\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("no_z", no_z)),
+                    contains_text("line 8: '3 0 1' is not a node (tag x y z)"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("no_z41", edited_beam("$Nodes", "\n0 0 0.1\n", "\n0 0\n"))),
+      contains_text("'0 0' is not a node's x y z"));
+  const std::string cube = cube22();
+  const std::string twice = cube + cube.substr(cube.find("$Elements"));
+  CHECK_THROWS_WITH(load_mesh(write_text("elements_twice", twice)),
+                    contains_text("a second $Elements section"));
+}
+
+TEST_CASE("two tetrahedra on the same four nodes are refused, by the file's tags", "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh(write_msh("tet_twice", kUnitTet, {{4, "1 2 3 4"}, {4, "2 1 4 3"}})),
+                    contains_text("tetrahedron 1 (element tag in the file) and tetrahedron 2 "
+                                  "(element tag in the file) have the same four nodes"));
+}
+
 TEST_CASE("a path that names no mesh file is refused as what it is", "[mesh]") {
   CHECK_THROWS_WITH(load_mesh(""), contains_text("an empty path names no file"));
   CHECK_THROWS_WITH(load_mesh(std::filesystem::temp_directory_path().string()),
