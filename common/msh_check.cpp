@@ -15,24 +15,27 @@ namespace {
 
 using Count = std::uint64_t;
 
-// The fewest bytes a record takes in an ASCII file, by which a header's count is checked
-// against the bytes left: a node is "1 0 0 0\n" (MSH 2.2) or "1\n" and "0 0 0\n" (MSH 4.1), an
-// element at least "1 1\n", an entity or a block header at least "0 1 0 0\n".
+// The fewest bytes a record takes in an ASCII file, by which a header's count
+// is checked against the bytes left: a node is "1 0 0 0\n" (MSH 2.2) or "1\n"
+// and "0 0 0\n" (MSH 4.1), an element at least "1 1\n", an entity or a block
+// header at least "0 1 0 0\n".
 constexpr Count kNodeBytes = 8, kElementBytes = 4, kHeaderBytes = 8;
 
 [[noreturn]] void fail_file(const std::string& file, const std::string& problem) {
   throw MeshError("mesh '" + file + "': " + problem);
 }
 
-// Reads the file line by line, counting the bytes read so that a header's count can be held
-// against the bytes left, and the lines, so that a message can point into the file.
+// Reads the file line by line, counting the bytes read so that a header's count
+// can be held against the bytes left, and the lines, so that a message can
+// point into the file.
 class MshReader {
  public:
   MshReader(const std::string& path, Count size) : path_(path), size_(size), in_(path) {
     if (!in_) fail("cannot open the file (missing or unreadable)");
   }
 
-  // The next line without its line end ("\r\n" too), or false at the end of the file.
+  // The next line without its line end ("\r\n" too), or false at the end of the
+  // file.
   bool next(std::string& line) {
     if (!std::getline(in_, line)) return false;
     read_ += line.size() + 1;
@@ -41,7 +44,8 @@ class MshReader {
     return true;
   }
 
-  // Whether the last line had no line end: the file's last, cut inside a section.
+  // Whether the last line had no line end: the file's last, cut inside a
+  // section.
   bool at_cut_end() const { return in_.eof(); }
   Count bytes_left() const { return read_ < size_ ? size_ - read_ : 0; }
   [[noreturn]] void fail(const std::string& problem) const { fail_file(path_, problem); }
@@ -53,15 +57,16 @@ class MshReader {
   std::ifstream in_;
 };
 
-// A section's records as its header declares them, for the messages of a cut or short section.
+// A section's records as its header declares them, for the messages of a cut or
+// short section.
 struct Records {
   std::string section;  // "Nodes"
   std::string noun;     // "nodes"
   Count declared = 0;
 };
 
-// The next record line of a section: the file's end or a '$' line there means the section
-// holds fewer records than its header declares.
+// The next record line of a section: the file's end or a '$' line there means
+// the section holds fewer records than its header declares.
 void next_record(MshReader& r, const Records& s, Count done, std::string& line) {
   const std::string progress =
       std::to_string(done) + " of its " + std::to_string(s.declared) + " " + s.noun + ")";
@@ -71,7 +76,8 @@ void next_record(MshReader& r, const Records& s, Count done, std::string& line) 
     r.fail(r.at() + ": section $" + s.section + " ends early (" + line + " after " + progress);
 }
 
-// The first n whitespace-separated integers of a line, or a message naming the line.
+// The first n whitespace-separated integers of a line, or a message naming the
+// line.
 template <std::size_t n>
 std::array<std::int64_t, n> integers(const MshReader& r, const std::string& line,
                                      const std::string& what) {
@@ -89,7 +95,8 @@ std::array<std::int64_t, n> integers(const MshReader& r, const std::string& line
   return out;
 }
 
-// Whether the line holds at least n whitespace-separated words (a node's tag and coordinates).
+// Whether the line holds at least n whitespace-separated words (a node's tag
+// and coordinates).
 bool has_words(const std::string& line, std::size_t n) {
   std::size_t words = 0;
   for (std::size_t i = 0; i < line.size() && words < n; ++i)
@@ -98,8 +105,8 @@ bool has_words(const std::string& line, std::size_t n) {
   return words >= n;
 }
 
-// A count from a header, refused when negative or when the bytes left cannot hold that many
-// records: checked before anything is sized by it.
+// A count from a header, refused when negative or when the bytes left cannot
+// hold that many records: checked before anything is sized by it.
 Count checked_count(const MshReader& r, std::int64_t count, const Records& s, Count min_bytes) {
   if (count < 0) r.fail(r.at() + ": section $" + s.section + " declares a negative count");
   const Count fits = r.bytes_left() / min_bytes;
@@ -150,7 +157,8 @@ void scan_nodes_22(MshReader& r, std::vector<Count>& tags) {
   expect_end(r, "Nodes");
 }
 
-// One entity block of MSH 4.1's $Nodes: its tags, one a line, then as many coordinate lines.
+// One entity block of MSH 4.1's $Nodes: its tags, one a line, then as many
+// coordinate lines.
 void scan_node_block_41(MshReader& r, const Records& s, std::vector<Count>& tags) {
   std::string line;
   next_record(r, s, tags.size(), line);
@@ -213,11 +221,39 @@ void scan_elements_41(MshReader& r) {
   expect_end(r, "Elements");
 }
 
-// MSH 4.1's $Entities: the four counts held against the file's size (gmsh reads that many).
+// MSH 4.1's $Entities: the four counts held against the file's size (gmsh reads
+// that many).
 void scan_entities_41(MshReader& r) {
   const Records s{"Entities", "entities", 0};
   for (const std::int64_t count : header<4>(r, s.section)) checked_count(r, count, s, kHeaderBytes);
   skip_section(r, "Entities");
+}
+
+// A line of one count that the bytes left must hold at `min_bytes` a record.
+Count count_line(MshReader& r, const Records& s, Count min_bytes) {
+  return checked_count(r, header<1>(r, s.section)[0], s, min_bytes);
+}
+
+// $NodeData, $ElementData, $ElementNodeData: tags (strings, reals, integers,
+// each a count and as many lines), then one line per entity. gmsh sizes its
+// arrays by the integer tags (the entities, their components), so they are held
+// against the bytes left too.
+void scan_data_section(MshReader& r, const std::string& section) {
+  std::string line;
+  for (const char* kind : {"string tags", "real tags"}) {
+    const Count n = count_line(r, {section, kind}, 2);
+    for (Count i = 0; i < n; ++i) next_record(r, {section, kind, n}, i, line);
+  }
+  const Records ints{section, "integer tags"};
+  const Count n = count_line(r, ints, 2);
+  Count components = 1;
+  for (Count i = 0; i < n; ++i) {
+    next_record(r, {section, "integer tags", n}, i, line);
+    const std::int64_t value = integers<1>(r, line, "an integer tag")[0];
+    if (i == 1) components = checked_count(r, value, {section, "components"}, 2);
+    if (i == 2) checked_count(r, value, {section, "entries"}, 2 * std::max<Count>(components, 1));
+  }
+  skip_section(r, section);
 }
 
 // The version from $MeshFormat: 2 (2.x) or 4 (4.1), ASCII only.
@@ -234,13 +270,15 @@ int read_format(MshReader& r) {
            ": the programs read MSH 4.1 and 2.2 (in gmsh: " + "Mesh.MshFileVersion = 4.1)");
   if (binary != 0)
     r.fail(
-        "a binary .msh file: the programs read ASCII files, whose counts they check before "
+        "a binary .msh file: the programs read ASCII files, whose counts "
+        "they check before "
         "reading (in gmsh: Mesh.Binary = 0)");
   expect_end(r, "MeshFormat");
   return version == "4.1" ? 4 : 2;
 }
 
-// The path names a regular file: an empty path, a directory or a device is refused by name.
+// The path names a regular file: an empty path, a directory or a device is
+// refused by name.
 Count checked_file_size(const std::string& path) {
   namespace fs = std::filesystem;
   if (path.empty()) fail_file(path, "an empty path names no file");
@@ -259,7 +297,8 @@ void refuse_duplicate_tags(const MshReader& r, std::vector<Count>& tags) {
   const auto twice = std::adjacent_find(tags.begin(), tags.end());
   if (twice != tags.end())
     r.fail("duplicate node tag " + std::to_string(*twice) +
-           ": the file defines that node twice (gmsh would keep the last and move the node)");
+           ": the file defines that node twice (gmsh would keep the last and "
+           "move the node)");
 }
 
 std::string missing_section(const std::string& section, const std::string& last) {
@@ -284,13 +323,18 @@ void check_msh_file(const std::string& path) {
       version == 4 ? scan_nodes_41(r, tags) : scan_nodes_22(r, tags);
       nodes = true;
     } else if (section == "Elements") {
-      // A second one adds its elements to the first's (gmsh reads both): a body stiffer and
-      // heavier than the file's first section says.
+      // A second one adds its elements to the first's (gmsh reads both): a body
+      // stiffer and heavier than the file's first section says.
       if (elements) r.fail(r.at() + ": a second $Elements section");
       version == 4 ? scan_elements_41(r) : scan_elements_22(r);
       elements = true;
     } else if (section == "Entities" && version == 4) {
       scan_entities_41(r);
+    } else if (section == "PhysicalNames") {
+      count_line(r, {section, "names"}, 6);  // "1 1 ""\n" at least
+      skip_section(r, section);
+    } else if (section == "NodeData" || section == "ElementData" || section == "ElementNodeData") {
+      scan_data_section(r, section);
     } else {
       skip_section(r, section);
     }

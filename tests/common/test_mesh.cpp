@@ -264,6 +264,26 @@ TEST_CASE("two tetrahedra on the same four nodes are refused, by the file's tags
                                   "(element tag in the file) have the same four nodes"));
 }
 
+TEST_CASE("the counts of $PhysicalNames and of data sections are held against the file too",
+          "[mesh]") {
+  const std::string cube = cube22();
+  const std::string head = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("names_huge", head +
+                                             "$PhysicalNames\n1000000000\n3 1 \"body\"\n"
+                                             "$EndPhysicalNames\n" +
+                                             cube.substr(head.size()))),
+      contains_text("$PhysicalNames section declares 1000000000 names"));
+  const std::string data = "$NodeData\n1\n\"d\"\n1\n0.0\n3\n0\n1\n";
+  std::string entries;
+  for (int i = 1; i <= 8; ++i) entries += std::to_string(i) + " 0.5\n";
+  CHECK(load_mesh(write_text("data_ok", cube + data + "8\n" + entries + "$EndNodeData\n"))
+            .num_tets() == 6);
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("data_huge", cube + data + "1000000000\n1 0.5\n$EndNodeData\n")),
+      contains_text("$NodeData section declares 1000000000 entries"));
+}
+
 TEST_CASE("a path that names no mesh file is refused as what it is", "[mesh]") {
   CHECK_THROWS_WITH(load_mesh(""), contains_text("an empty path names no file"));
   CHECK_THROWS_WITH(load_mesh(std::filesystem::temp_directory_path().string()),

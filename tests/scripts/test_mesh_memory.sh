@@ -25,7 +25,12 @@ tet41() {  # MSH 4.1 single tetrahedron; $1 the node count, $2 the element count
   printf '0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n$Elements\n1 %s 1 1\n3 1 4 1\n' "$2"
   printf '1 1 2 3 4\n$EndElements\n'
 }
+nodedata() {  # a $NodeData section claiming $1 entries after the cube
+  cube22 8 6
+  printf '$NodeData\n1\n"d"\n1\n0.0\n3\n0\n1\n%s\n1 0.5\n$EndNodeData\n' "$1"
+}
 cube22 1000000000 6 >nodes22.msh
+nodedata 1000000000 >nodedata22.msh
 cube22 8 1000000000 >elements22.msh
 tet41 1000000000 1 >nodes41.msh
 tet41 4 1000000000 >elements41.msh
@@ -56,10 +61,10 @@ for program in "${programs[@]}"; do
   if [ "$base_kb" -eq 0 ]; then
     echo "FAIL: $(basename "$program") does not run the test mesh under 4 GiB"; failed=1; continue
   fi
-  for file in nodes22 elements22 nodes41 elements41; do
+  for file in nodes22 elements22 nodes41 elements41 nodedata22; do
     limit_kb=$((base_kb + 2 * $(stat -c %s "$file.msh") / 1024 + margin_kb))
     out=$( (ulimit -v "$limit_kb" && $(command_for "$program" "$file.msh")) 2>&1)
-    if printf '%s' "$out" | grep -q "declares 1000000000 \(nodes\|elements\), more than the file can hold"; then
+    if printf '%s' "$out" | grep -q "declares 1000000000 \(nodes\|elements\|entries\), more than the file can hold"; then
       echo "ok: $(basename "$program") refuses $file.msh under ulimit -v $limit_kb"
     else
       echo "FAIL: $(basename "$program") on $file.msh under ulimit -v $limit_kb: $out"; failed=1
