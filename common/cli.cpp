@@ -116,8 +116,12 @@ double ArgParser::get_double(const std::string& name) const {
 
 int ArgParser::get_int(const std::string& name) const {
   const std::optional<int> v = parse_int(get(name));
-  if (!v) throw UsageError("--" + name + " expects an integer, got '" + get(name) + "'");
-  return *v;
+  if (v) return *v;
+  // An integer too large for an int (--every 1000000000000) is an integer: say so.
+  const std::optional<double> number = parse_double(get(name));
+  if (number && *number == std::floor(*number) && std::abs(*number) > 2147483647.0)
+    throw UsageError("--" + name + " " + get(name) + " is out of range (at most 2147483647)");
+  throw UsageError("--" + name + " expects an integer, got '" + get(name) + "'");
 }
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
