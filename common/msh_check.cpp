@@ -95,14 +95,41 @@ std::array<std::int64_t, n> integers(const MshReader& r, const std::string& line
   return out;
 }
 
-// Whether the line holds at least n whitespace-separated words (a node's tag
-// and coordinates).
-bool has_words(const std::string& line, std::size_t n) {
-  std::size_t words = 0;
-  for (std::size_t i = 0; i < line.size() && words < n; ++i)
-    if (line[i] != ' ' && line[i] != '\t' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t'))
-      ++words;
-  return words >= n;
+// The whitespace-separated words of a line (a node's tag and coordinates, an element's nodes).
+std::size_t words(const std::string& line) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < line.size(); ++i)
+    n += line[i] != ' ' && line[i] != '\t' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t');
+  return n;
+}
+
+// The nodes of gmsh's element types up to 19 (points, lines, triangles, quadrangles,
+// tetrahedra, hexahedra, prisms, pyramids, first and second order); 0 for another type, whose
+// lines are then not counted.
+std::size_t nodes_of_type(std::int64_t type) {
+  static constexpr std::array<std::size_t, 20> kNodes = {0, 2,  3,  4,  4,  8, 6, 5,  3,  6,
+                                                         9, 10, 27, 18, 14, 1, 8, 20, 15, 13};
+  return type > 0 && type < static_cast<std::int64_t>(kNodes.size()) ? kNodes[type] : 0;
+}
+
+// An element line holds exactly its type's nodes after `before` words: a node missing or too
+// many shifts gmsh's reading of every later line (a tetrahedron one node short was read as a
+// prism).
+void check_element_words(const MshReader& r, const std::string& line, std::int64_t type,
+                         std::size_t before) {
+  const std::size_t nodes = nodes_of_type(type);
+  if (nodes > 0 && words(line) != before + nodes)
+    r.fail(r.at() + ": element '" + line + "' of gmsh type " + std::to_string(type) + " lists " +
+           std::to_string(words(line) - std::min(words(line), before)) + " nodes, not its " +
+           std::to_string(nodes));
+}
+
+// A node's tag: gmsh numbers nodes from 1.
+Count node_tag(const MshReader& r, const std::string& line, const std::string& what) {
+  const std::int64_t tag = integers<1>(r, line, what)[0];
+  if (tag < 1)
+    r.fail(r.at() + ": node tag " + std::to_string(tag) + " (gmsh numbers nodes from 1)");
+  return static_cast<Count>(tag);
 }
 
 // A count from a header, refused when negative or when the bytes left cannot
@@ -151,8 +178,8 @@ void scan_nodes_22(MshReader& r, std::vector<Count>& tags) {
   std::string line;
   for (Count i = 0; i < s.declared; ++i) {
     next_record(r, s, i, line);
-    if (!has_words(line, 4)) r.fail(r.at() + ": '" + line + "' is not a node (tag x y z)");
-    tags.push_back(static_cast<Count>(integers<1>(r, line, "a node (tag x y z)")[0]));
+    if (words(line) < 4) r.fail(r.at() + ": '" + line + "' is not a node (tag x y z)");
+    tags.push_back(node_tag(r, line, "a node (tag x y z)"));
   }
   expect_end(r, "Nodes");
 }
@@ -170,11 +197,11 @@ void scan_node_block_41(MshReader& r, const Records& s, std::vector<Count>& tags
   const Count done = tags.size(), in_block = static_cast<Count>(block[3]);
   for (Count i = 0; i < in_block; ++i) {
     next_record(r, s, done + i, line);
-    tags.push_back(static_cast<Count>(integers<1>(r, line, "a node tag")[0]));
+    tags.push_back(node_tag(r, line, "a node tag"));
   }
   for (Count i = 0; i < in_block; ++i) {
     next_record(r, s, done + i, line);
-    if (!has_words(line, 3)) r.fail(r.at() + ": '" + line + "' is not a node's x y z");
+    if (words(line) < 3) r.fail(r.at() + ": '" + line + "' is not a node's x y z");
   }
 }
 
@@ -187,9 +214,7 @@ void scan_nodes_41(MshReader& r, std::vector<Count>& tags) {
   for (Count b = 0; b < blocks; ++b) scan_node_block_41(r, s, tags);
   if (tags.size() != s.declared)
     r.fail("its $Nodes section declares " + std::to_string(s.declared) +
-           " nodes and its blocks "
-           "hold " +
-           std::to_string(tags.size()));
+           " nodes and its blocks hold " + std::to_string(tags.size()));
   expect_end(r, "Nodes");
 }
 
@@ -197,7 +222,12 @@ void scan_elements_22(MshReader& r) {
   Records s{"Elements", "elements", 0};
   s.declared = checked_count(r, header<1>(r, s.section)[0], s, kElementBytes);
   std::string line;
-  for (Count i = 0; i < s.declared; ++i) next_record(r, s, i, line);
+  for (Count i = 0; i < s.declared; ++i) {
+    next_record(r, s, i, line);
+    const auto head = integers<3>(r, line, "an element (tag type tag-count tags nodes)");
+    check_element_words(r, line, head[1],
+                        3 + static_cast<std::size_t>(std::max<std::int64_t>(head[2], 0)));
+  }
   expect_end(r, "Elements");
 }
 
@@ -216,7 +246,10 @@ void scan_elements_41(MshReader& r) {
              " elements where the header's " + std::to_string(s.declared) + " leave " +
              std::to_string(s.declared - done));
     const Count end = done + static_cast<Count>(block[3]);
-    for (; done < end; ++done) next_record(r, s, done, line);
+    for (; done < end; ++done) {
+      next_record(r, s, done, line);
+      check_element_words(r, line, block[2], 1);
+    }
   }
   expect_end(r, "Elements");
 }
@@ -260,7 +293,9 @@ void scan_data_section(MshReader& r, const std::string& section) {
 int read_format(MshReader& r) {
   std::string line;
   if (!r.next(line) || line != "$MeshFormat")
-    r.fail("not a gmsh .msh file (its first line is not $MeshFormat)");
+    r.fail(line.rfind("\xEF\xBB\xBF", 0) == 0
+               ? "it starts with a byte-order mark before $MeshFormat: save it without one"
+               : "not a gmsh .msh file (its first line is not $MeshFormat)");
   if (!r.next(line)) r.fail("the file ends inside section $MeshFormat");
   const std::string version = line.substr(0, line.find(' '));
   const auto words = line.substr(version.size());

@@ -284,6 +284,23 @@ TEST_CASE("the counts of $PhysicalNames and of data sections are held against th
       contains_text("$NodeData section declares 1000000000 entries"));
 }
 
+TEST_CASE("an element line short of a node, a node tag 0, a byte-order mark are named", "[mesh]") {
+  // gmsh read the tetrahedron one node short together with the next line, as a prism.
+  CHECK_THROWS_WITH(
+      load_mesh(write_msh("tet_short", kUnitTet, {{4, "1 2 3"}, {4, "1 2 3 4"}})),
+      contains_text("element '1 4 2 0 1 1 2 3' of gmsh type 4 lists 3 nodes, not its 4"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text(
+          "tet_short41", edited_beam("$Elements", "\n1 106 162 151 138 \n", "\n1 106 162 151\n"))),
+      contains_text("'1 106 162 151' of gmsh type 4 lists 3 nodes, not its 4"));
+  std::string tag0 = cube22();
+  tag0.replace(tag0.find("\n1 0 0 0\n"), 9, "\n0 0 0 0\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("tag0", tag0)),
+                    contains_text("node tag 0 (gmsh numbers nodes from 1)"));
+  CHECK_THROWS_WITH(load_mesh(write_text("bom", "\xEF\xBB\xBF" + cube22())),
+                    contains_text("byte-order mark"));
+}
+
 TEST_CASE("a path that names no mesh file is refused as what it is", "[mesh]") {
   CHECK_THROWS_WITH(load_mesh(""), contains_text("an empty path names no file"));
   CHECK_THROWS_WITH(load_mesh(std::filesystem::temp_directory_path().string()),
