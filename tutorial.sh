@@ -41,7 +41,8 @@ usage: ./tutorial.sh <command> [arguments passed to the program]
 
 commands:
   setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
-  build      set up if needed and build (preset: \$PRESET, default release)
+  build      set up if needed and build (preset: \$PRESET, default release); one build at a time
+             in a build folder: a command that builds while another does waits for it, saying so
   test       build and run every test through ctest but the new-chapter test, which builds a
              copy of the repository (ctest arguments may follow, e.g. -L ch01 or -L new-chapter)
   bench      build (quietly) and benchmark every chapter on the poster-sized mesh: prints the

@@ -10,11 +10,13 @@
 namespace fem {
 
 // Throws MeshError, naming the file and the cause, for: an empty path, a directory or other
-// non-regular file, a file that is not an ASCII MSH 2.2 or 4.1 file, a header count that the
-// file's size cannot hold (checked before anything is sized by it), a file that ends inside
-// or after a section ("the file ends inside section $Nodes"), a section without its $Nodes or
-// $Elements, and a node tag defined twice. Reads the file once; its memory is one tag per
-// node, bounded by the file's size.
+// non-regular file, an empty file, a file that is not an ASCII MSH 2.2 or 4.1 file (a
+// byte-order mark named), a header count ($Nodes, $Elements and their blocks, $Entities,
+// $PhysicalNames, the data sections' tags) that the bytes left cannot hold, checked before
+// anything is sized by it; a file that ends inside or after a section ("the file ends inside
+// section $Nodes"), a missing $Nodes or $Elements or a second one; a node line without its
+// coordinates, an element line without its type's nodes; a node tag below 1 or defined twice.
+// Reads the file once; its memory is one tag per node, bounded by the file's size.
 void check_msh_file(const std::string& path);
 
 }  // namespace fem
