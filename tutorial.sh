@@ -41,7 +41,8 @@ usage: ./tutorial.sh <command> [arguments passed to the program]
 
 commands:
   setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
-  build      set up if needed and build (preset: \$PRESET, default release)
+  build      set up if needed and build (preset: \$PRESET, default release); one build at a time
+             in a build folder: a command that builds while another does waits for it, saying so
   test       build and run every test through ctest but the new-chapter test, which builds a
              copy of the repository (ctest arguments may follow, e.g. -L ch01 or -L new-chapter)
   bench      build (quietly) and benchmark every chapter on the poster-sized mesh: prints the
@@ -220,10 +221,28 @@ setup() {
   configure
 }
 
+# One build at a time in a build folder: two commands started together (two benches on a
+# stale build) once ran two ninjas in one folder, and one failed with a linker error that read
+# like a code error. The lock (flock on a file in the build folder, fd 9) covers the set-up,
+# the build and its log; it is released when the build ends, before the programs run, or with
+# the process. The second command waits for it, saying so.
+take_build_lock() {
+  mkdir -p "$BUILD_DIR"
+  exec 9>"$BUILD_DIR/.build.lock"
+  flock -n 9 && return 0
+  echo "another command is building in ${BUILD_DIR#"$ROOT"/}: waiting for its build to end" >&2
+  flock 9
+  echo "the other build ended: building" >&2
+}
+
+release_build_lock() { exec 9>&-; }
+
 build() {
+  take_build_lock
   setup
   log "building (preset $PRESET)"
   cmake --build --preset "$PRESET"
+  release_build_lock
 }
 
 # Ninja's progress from the build's output, "[n/N] what": on a terminal one line rewritten in
@@ -251,6 +270,7 @@ build_progress() {
 # The build with its log kept out of the way of the results that follow: ninja's progress, the
 # log's tail on failure, and the warnings (if any) named.
 quiet_build() {
+  take_build_lock
   setup
   local build_log="$BUILD_DIR/build.log"
   log "building (preset $PRESET; log in ${build_log#"$ROOT"/})"
@@ -263,6 +283,7 @@ quiet_build() {
   local warnings
   warnings=$(grep -c "warning:" "$build_log" || true)
   [ "$warnings" -eq 0 ] || echo "the build printed $warnings warnings: see $build_log" >&2
+  release_build_lock
 }
 
 run_tests() {
@@ -552,7 +573,7 @@ main() {
   cmd="${1:-help}"
   [ $# -gt 0 ] && shift
   case "$cmd" in
-    setup) setup ;;
+    setup) take_build_lock; setup ;;
     build) build ;;
     test) run_tests "$@" ;;
     bench) bench "$@" ;;

@@ -116,6 +116,21 @@ std::string measure(const Lesson& lesson, const LessonRun& run) {
   return table + "\n**Measured on a busy machine:** " + load.warning() + "\n";
 }
 
+// A lesson's chapter lists (the roofline's --chapters, --other-chapters, --alone-chapters),
+// checked before any measurement as fem_bench checks its --chapters: each chapter known, none
+// named twice. The roofline measured a repeated chapter twice, and refused an unknown one only
+// after its roofs (about 10 s).
+void check_chapter_lists(const ArgParser& args) {
+  for (const std::string name : {"chapters", "other-chapters", "alone-chapters"}) {
+    if (!args.has_option(name) || args.get_list(name).empty()) continue;
+    try {
+      find_chapters(args.get_list(name));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError("--" + name + ": " + e.what());
+    }
+  }
+}
+
 // Runs one lesson; argv[0] is its name. A variant's table is printed after the original's.
 int run_lesson(const Found& found, int argc, char** argv) {
   const std::string program = "fem_lessons " + found.lesson.name;
@@ -131,6 +146,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
   return run_program(program, [&] {
     if (!args.parse(argc, argv)) return 0;
     threads_from_args(args);
+    check_chapter_lists(args);
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
@@ -145,6 +161,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
     if ((!readme.empty() || !json.empty()) && runs.size() > 1)
       throw UsageError("--readme and --json record the course's table: leave --chapter out");
     if (!json.empty()) check_json_writable(json);
+    if (!readme.empty()) check_markers(readme, found.lesson.name + "-table");
     // A lesson may leave std::fixed and a precision on the streams: the next run (a
     // variant's, after the original's) starts from the streams' defaults again.
     std::ios cout_defaults(nullptr), cerr_defaults(nullptr);

@@ -1,7 +1,9 @@
 #include "common/cli.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -101,15 +103,25 @@ const std::string& ArgParser::get(const std::string& name) const { return option
 
 double ArgParser::get_double(const std::string& name) const {
   const std::optional<double> v = parse_double(get(name));
-  if (!v || !std::isfinite(*v))
-    throw UsageError("--" + name + " expects a finite number, got '" + get(name) + "'");
-  return *v;
+  if (v && std::isfinite(*v)) return *v;
+  // A number too small or too large for a double (1e-320, 1e400) is a number: say so, rather
+  // than that it is not a finite one.
+  errno = 0;
+  const double magnitude = std::strtod(get(name).c_str(), nullptr);
+  if (!v && errno == ERANGE)
+    throw UsageError("--" + name + " " + get(name) + " is out of a double's range (" +
+                     (std::abs(magnitude) < 1.0 ? "below 2.2e-308" : "above 1.8e+308") + ")");
+  throw UsageError("--" + name + " expects a finite number, got '" + get(name) + "'");
 }
 
 int ArgParser::get_int(const std::string& name) const {
   const std::optional<int> v = parse_int(get(name));
-  if (!v) throw UsageError("--" + name + " expects an integer, got '" + get(name) + "'");
-  return *v;
+  if (v) return *v;
+  // An integer too large for an int (--every 1000000000000) is an integer: say so.
+  const std::optional<double> number = parse_double(get(name));
+  if (number && *number == std::floor(*number) && std::abs(*number) > 2147483647.0)
+    throw UsageError("--" + name + " " + get(name) + " is out of range (at most 2147483647)");
+  throw UsageError("--" + name + " expects an integer, got '" + get(name) + "'");
 }
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
@@ -167,6 +179,9 @@ void add_scene_options(ArgParser& args, const std::string& default_mesh) {
 
 std::string resolve_mesh_path(const std::string& path) {
   namespace fs = std::filesystem;
+  // An empty path stays empty (load_mesh refuses it): joined to the source folder it named
+  // the folder itself.
+  if (path.empty()) return path;
   if (fs::path(path).is_relative() && !fs::exists(path) &&
       fs::exists(fs::path(source_dir()) / path))
     return (fs::path(source_dir()) / path).string();
@@ -274,19 +289,41 @@ int threads_from_args(const ArgParser& args) {
   return max_threads();
 }
 
-void write_between_markers(const std::string& path, const std::string& name,
-                           const std::string& text) {
+namespace {
+
+// The file's text and where the text between its markers <!-- NAME:begin/end --> starts and
+// ends; throws std::runtime_error naming what is missing.
+struct MarkedDoc {
+  std::string text;
+  std::size_t from = 0, to = 0;
+};
+
+MarkedDoc read_marked(const std::string& path, const std::string& name) {
+  if (std::filesystem::is_directory(path))
+    throw std::runtime_error("'" + path + "' is a directory, not a file with markers");
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read '" + path + "'");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  std::string doc = buffer.str();
+  MarkedDoc doc{buffer.str()};
   const std::string begin = "<!-- " + name + ":begin -->", end = "<!-- " + name + ":end -->";
-  const auto b = doc.find(begin), e = doc.find(end);
+  const auto b = doc.text.find(begin), e = doc.text.find(end);
   if (b == std::string::npos || e == std::string::npos || e < b)
     throw std::runtime_error("'" + path + "' has no markers " + begin + " ... " + end);
-  doc.replace(b + begin.size(), e - b - begin.size(), "\n" + text);
-  write_file_atomically(path, doc);
+  doc.from = b + begin.size();
+  doc.to = e;
+  return doc;
+}
+
+}  // namespace
+
+void check_markers(const std::string& path, const std::string& name) { read_marked(path, name); }
+
+void write_between_markers(const std::string& path, const std::string& name,
+                           const std::string& text) {
+  MarkedDoc doc = read_marked(path, name);
+  doc.text.replace(doc.from, doc.to - doc.from, "\n" + text);
+  write_file_atomically(path, doc.text);
 }
 
 void announce_long_run(const std::string& program, double seconds_per_step, long long steps) {

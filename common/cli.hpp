@@ -41,6 +41,7 @@ class ArgParser {
   double get_double(const std::string& name) const;  // throws UsageError if not a number
   int get_int(const std::string& name) const;        // throws UsageError if not an integer
   bool has_flag(const std::string& name) const;
+  bool has_option(const std::string& name) const { return options_.count(name) > 0; }
   // The option's comma-separated items, empty ones skipped: "09,,12" -> {"09", "12"}; "" -> {}.
   std::vector<std::string> get_list(const std::string& name) const;
   // The items as integers, a repeated one kept once (at its first place); throws UsageError
@@ -103,5 +104,7 @@ std::string resolve_mesh_path(const std::string& path);
 // file cannot be read or has no such markers.
 void write_between_markers(const std::string& path, const std::string& name,
                            const std::string& text);
+// The same checks alone, before the work whose text goes there (a lesson's measurement).
+void check_markers(const std::string& path, const std::string& name);
 
 }  // namespace fem

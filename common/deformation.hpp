@@ -27,6 +27,7 @@ struct DeformationCheck {
   double largest_stretch = 1.0;  // max over edges of deformed length / rest length
   double energy = 0.0;           // kinetic + elastic + gravity's potential (0 at rest) [J]
   double energy_content = 0.0;   // kinetic + elastic [J]: the scale the growth is measured on
+  double energy_noise = 0.0;     // gravity's potential to its last digits [J]: no growth below
 };
 
 // The thresholds, from the course's scenes (the default cantilever, 200 steps on the poster's

@@ -40,6 +40,22 @@ std::string tet_name(const MeshTags& tags, std::size_t e) {
   return "tetrahedron " + std::to_string(e);
 }
 
+// Two tetrahedra on the same four nodes (a file's element listed twice, a second $Elements
+// section) double that element's mass and stiffness without a word: refused by name.
+void refuse_repeated_tets(const std::vector<Eigen::Vector4i>& tets, const std::string& name,
+                          const MeshTags& tags) {
+  std::vector<std::pair<std::array<int, 4>, std::size_t>> sorted(tets.size());
+  for (std::size_t e = 0; e < tets.size(); ++e) {
+    sorted[e] = {{tets[e][0], tets[e][1], tets[e][2], tets[e][3]}, e};
+    std::sort(sorted[e].first.begin(), sorted[e].first.end());
+  }
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t k = 1; k < sorted.size(); ++k)
+    if (sorted[k].first == sorted[k - 1].first)
+      fail(name, tet_name(tags, sorted[k - 1].second) + " and " + tet_name(tags, sorted[k].second) +
+                     " have the same four nodes");
+}
+
 void check_arrays(const Eigen::Matrix3Xd& X, const std::vector<Eigen::Vector4i>& tets,
                   const std::string& name, const MeshTags& tags) {
   if (tets.empty())
@@ -53,6 +69,7 @@ void check_arrays(const Eigen::Matrix3Xd& X, const std::vector<Eigen::Vector4i>&
     for (int i = 0; i < 4; ++i)
       if (tets[e][i] < 0 || tets[e][i] >= X.cols())
         fail(name, tet_name(tags, e) + " refers to a missing node");
+  refuse_repeated_tets(tets, name, tags);
 }
 
 // Drops the nodes no tetrahedron uses and renumbers the rest densely, in their order.

@@ -5,13 +5,13 @@
 #include <gmsh.h>
 
 #include <algorithm>
-#include <fstream>
 #include <mutex>
 #include <numeric>
 #include <unordered_map>
 
 #include "common/cli.hpp"
 #include "common/mesh.hpp"
+#include "common/msh_check.hpp"
 
 // Named by fem_mesh_gmsh's link option -u (CMakeLists.txt): it pulls this file into every
 // program that links the reader, so that its load_mesh wins over fem_fallbacks'.
@@ -84,10 +84,9 @@ void refuse_other_volume_elements(const std::string& path) {
 }  // namespace
 
 TetMesh load_mesh(const std::string& path) {
-  {
-    std::ifstream probe(path);
-    if (!probe) fail(path, "cannot open the file (missing or unreadable)");
-  }
+  // Before gmsh: it sizes its arrays by the file's header counts and keeps the last of two
+  // nodes with one tag, so a cut or corrupt file is refused here with its cause.
+  check_msh_file(path);
   std::lock_guard<std::mutex> lock(gmsh_mutex());
   ensure_gmsh_initialized();
   gmsh::clear();

@@ -54,6 +54,7 @@ void step(RunningChapter& run, int k, bool measured) {
   alloc::Scope counter;
   run.stepper->step(run.state);
   const long long allocs = counter.allocations();
+  stop_if_interrupted();
   if (const char* why = divergence(run.state, run.stepper->profile()))
     throw std::runtime_error(run.result.chapter + ": the simulation diverged at step " +
                              std::to_string(k + 1) + " (" + why + ")");

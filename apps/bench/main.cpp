@@ -4,6 +4,7 @@
 // file: options (the command line), chapter_runs (the interleaved chapters), solve_tables
 // (the poster's solve table), report_console and report_json (the results), run_folder (the
 // results' folder); the order statistics are common/statistics.hpp's.
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -30,12 +31,10 @@ std::vector<SolverResult> solve_tables(const Scene& scene, const BenchOptions& o
   return solvers;
 }
 
-int run_bench(const ArgParser& args) {
-  const BenchOptions options = bench_options(args);
-  // The folder is this run's before any work: a second run into it is refused, naming this one.
-  const std::optional<RunLock> lock = lock_run_folder(options);
-  const bool replacing = !options.json.empty() && std::filesystem::exists(options.json);
-  if (replacing && !options.replace) throw UsageError(holds_a_run(options.json));
+extern "C" void request_stop(int) { interrupted = 1; }
+
+// The measurements and their JSON, after the checks and the lock of run_bench.
+int measure_and_write(const ArgParser& args, const BenchOptions& options, bool replacing) {
   const Scene scene = scene_from_args(args);
   if (!options.json.empty()) check_writable(options.json);
   const SourceState source = source_state();
@@ -62,6 +61,26 @@ int run_bench(const ArgParser& args) {
   return 0;
 }
 
+int run_bench(const ArgParser& args) {
+  const BenchOptions options = bench_options(args);
+  // The folder is this run's before any work: a second run into it is refused, naming this one.
+  const std::optional<RunLock> lock = lock_run_folder(options);
+  const bool replacing = !options.json.empty() && std::filesystem::exists(options.json);
+  if (replacing && !options.replace) throw UsageError(holds_a_run(options.json));
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
+  try {
+    return measure_and_write(args, options, replacing);
+  } catch (const Interrupted&) {
+    std::cout << std::endl;
+    std::cerr << "fem_bench: stopped (Ctrl-C or SIGTERM) before the results: nothing of this run "
+              << "written"
+              << (replacing ? "; the earlier run in " + options.json + " is as it was" : "")
+              << std::endl;
+    throw;  // the lock released on the way out
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,5 +89,9 @@ int main(int argc, char** argv) {
                  "CG iterations; prints a table and writes JSON (schema in README.md) into the\n"
                  "run's folder (--out), where ./tutorial.sh bench also writes the plots.");
   add_bench_options(args);
-  return run_program("fem_bench", [&] { return args.parse(argc, argv) ? run_bench(args) : 0; });
+  try {
+    return run_program("fem_bench", [&] { return args.parse(argc, argv) ? run_bench(args) : 0; });
+  } catch (const Interrupted&) {
+    return 130;
+  }
 }

@@ -31,6 +31,10 @@ std::string json_path(const ArgParser& args) {
   if (args.has_flag("no-json")) {
     if (args.has_flag("json") && !args.get("json").empty())
       throw UsageError("--no-json and --json " + args.get("json") + " contradict each other");
+    // --out names the folder of the JSON and its plots: with --no-json it would be ignored.
+    if (args.has_flag("out") && !args.get("out").empty())
+      throw UsageError("--no-json and --out " + args.get("out") +
+                       " contradict each other (--out is the folder of the run's JSON)");
     return "";
   }
   if (!args.get("json").empty()) return args.get("json");

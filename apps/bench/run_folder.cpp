@@ -20,7 +20,7 @@ void check_writable(const std::string& path) {
       throw UsageError("cannot write the results into '" + dir.string() +
                        "': " + (error ? error.message() : "not a directory"));
   }
-  if (fs::is_directory(file)) throw UsageError("'" + path + "' is a directory, not a JSON file");
+  if (fs::is_directory(file)) throw UsageError(holds_a_run(path));
   const bool existed = fs::exists(file);
   if (!std::ofstream(file, std::ios::app))
     throw UsageError("cannot write '" + path + "' (permissions?)");
@@ -49,6 +49,9 @@ std::optional<RunLock> lock_run_folder(const BenchOptions& options) {
 }
 
 std::string holds_a_run(const std::string& json) {
+  if (fs::is_directory(json))
+    return "'" + json + "' is a directory, not a JSON file: give a file (--json " +
+           (fs::path(json) / "bench.json").string() + "), or the folder as --out " + json;
   return "'" + json +
          "' holds an earlier run: give another --out (or --json), or --replace to replace it "
          "and its plots";

@@ -21,7 +21,8 @@ void check_writable(const std::string& path);
 // that holds it.
 std::optional<RunLock> lock_run_folder(const BenchOptions& options);
 
-// "'PATH' holds an earlier run: ...": the refusal without --replace.
+// "'PATH' holds an earlier run: ...": the refusal without --replace; for a directory given as
+// --json, that it is one (--replace, which that refusal suggests, cannot help there).
 std::string holds_a_run(const std::string& json);
 
 // results/latest -> results/FOLDER (a relative symbolic link), the convention for "the newest

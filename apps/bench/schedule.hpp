@@ -7,6 +7,7 @@
 #pragma once
 
 #include <algorithm>
+#include <csignal>
 
 namespace fem::bench {
 
@@ -19,5 +20,15 @@ struct Schedule {
   // After step k (from 0): another fifth of the run is done.
   bool reports(int k) const { return (k + 1) % std::max(1, total() / 5) == 0; }
 };
+
+// Ctrl-C (SIGINT) or SIGTERM, set by fem_bench's handler (main.cpp) and checked after every
+// step: the run stops between steps and unwinds, so that its folder's lock is released and an
+// earlier bench.json stays as it was, with a message (it once died by the signal, silent, its
+// lock left behind).
+inline volatile std::sig_atomic_t interrupted = 0;
+struct Interrupted {};  // not a std::exception: main() answers it with 130, as a shell does
+inline void stop_if_interrupted() {
+  if (interrupted) throw Interrupted{};
+}
 
 }  // namespace fem::bench

@@ -249,6 +249,7 @@ std::vector<SolverResult> run_solvers(const Scene& scene, const SolverSettings& 
   for (int k = 0; k < schedule.total(); ++k) {
     report_progress("solve table", k, schedule);
     stepper.step(state);
+    stop_if_interrupted();
     table.solve(stepper.system_matrix(), stepper.system_rhs(), schedule.measured(k));
   }
   return table.results();
@@ -269,6 +270,7 @@ std::vector<SolverResult> run_threaded_solvers(const Scene& scene, const SolverS
   for (int k = 0; k < schedule.total(); ++k) {
     report_progress("solve table, threaded rows", k, schedule);
     stepper.step(state);
+    stop_if_interrupted();
     const RowMajorMatrix A = stepper.system_matrix().to_sparse();  // not timed
     for (ThreadedRow& row : rows) {
       solvers.solve(row, A, previous, x, schedule.measured(k));

@@ -59,3 +59,19 @@ TEST_CASE("chapter 10's settings are checked once, by check(), the lesson's rule
   s.multigrid.rows.serial_rows = -1;
   CHECK_THROWS_AS(ch10::check(s), std::invalid_argument);
 }
+
+TEST_CASE("a number out of a double's range is named as such, not as not finite") {
+  CHECK_THROWS_WITH(parsed("1e-320").get_double("list"),
+                    test::contains_text("out of a double's range (below 2.2e-308"));
+  CHECK_THROWS_WITH(parsed("1e400").get_double("list"),
+                    test::contains_text("out of a double's range (above 1.8e+308)"));
+  CHECK_THROWS_WITH(parsed("nan").get_double("list"), test::contains_text("expects a finite"));
+  CHECK(parsed("1e-300").get_double("list") == 1e-300);
+}
+
+TEST_CASE("an integer out of an int's range is named as such, not as not an integer") {
+  CHECK_THROWS_WITH(parsed("1000000000000").get_int("list"),
+                    test::contains_text("1000000000000 is out of range (at most 2147483647)"));
+  CHECK_THROWS_WITH(parsed("1.5").get_int("list"), test::contains_text("expects an integer"));
+  CHECK(parsed("2147483647").get_int("list") == 2147483647);
+}

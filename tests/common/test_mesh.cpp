@@ -3,8 +3,10 @@
 #include <Eigen/LU>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "catch2_compat.hpp"
 #include "common/mesh.hpp"
@@ -145,4 +147,170 @@ TEST_CASE("nodes used by no tetrahedron are dropped", "[mesh]") {
   CHECK(mesh.dropped_nodes == 1);
   CHECK(mesh.X.col(0).norm() == 0.0);  // renumbered: the first used node, (0, 0, 0)
   CHECK(mesh.tets[0] == Eigen::Vector4i(0, 1, 2, 3));
+}
+
+// ---- the file's structure, checked before gmsh reads it (common/msh_check.hpp) ------------
+namespace {
+
+std::string write_text(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("fem_test_" + name + ".msh");
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The committed MSH 4.1 test mesh with `from` replaced by `to` once, after `after`.
+std::string edited_beam(const std::string& after, const std::string& from, const std::string& to) {
+  std::string text = read_text(test::mesh_path("test_beam.msh"));
+  const auto at = text.find(from, text.find(after));
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+// The header line that follows `section` ("$Nodes\n") in the test mesh, its second count
+// (the nodes or elements) replaced by a billion.
+std::string beam_claiming_a_billion(const std::string& section) {
+  const std::string text = read_text(test::mesh_path("test_beam.msh"));
+  const auto start = text.find(section) + section.size();
+  std::istringstream header(text.substr(start, text.find('\n', start) - start));
+  std::string blocks, count;
+  header >> blocks >> count;
+  return edited_beam(section, section + blocks + " " + count + " ",
+                     section + blocks + " 1000000000 ");
+}
+
+std::string cube22(const std::string& node_count = "8", const std::string& node8 = "8 1 1 1") {
+  return "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" + node_count +
+         "\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n5 0 0 1\n6 1 0 1\n7 0 1 1\n" + node8 +
+         "\n$EndNodes\n$Elements\n6\n1 4 2 0 1 1 2 4 8\n2 4 2 0 1 1 2 8 6\n3 4 2 0 1 1 3 8 4\n"
+         "4 4 2 0 1 1 3 7 8\n5 4 2 0 1 1 5 6 8\n6 4 2 0 1 1 5 8 7\n$EndElements\n";
+}
+
+}  // namespace
+
+TEST_CASE("the committed meshes pass the structure check, also with CRLF line ends", "[mesh]") {
+  CHECK(load_mesh(write_text("cube22", cube22())).num_tets() == 6);
+  std::string crlf = read_text(test::mesh_path("test_beam.msh"));
+  for (auto at = crlf.find('\n'); at != std::string::npos; at = crlf.find('\n', at + 2))
+    crlf.insert(at, "\r");
+  CHECK(load_mesh(write_text("crlf", crlf)).num_tets() == test::test_mesh().num_tets());
+}
+
+TEST_CASE("a node tag defined twice is refused, not the last definition kept", "[mesh]") {
+  // MSH 2.2: a ninth line defines tag 7 again, at (0,1,2); gmsh alone keeps it, moves node 7.
+  CHECK_THROWS_WITH(load_mesh(write_text("dup22", cube22("9", "8 1 1 1\n7 0 1 2"))),
+                    contains_text("duplicate node tag 7"));
+  // MSH 4.1: the second node's tag line repeats the first's.
+  CHECK_THROWS_WITH(load_mesh(write_text("dup41", edited_beam("$Nodes", "\n2\n", "\n1\n"))),
+                    contains_text("duplicate node tag 1"));
+}
+
+TEST_CASE("a header count the file's size cannot hold is refused with both numbers", "[mesh]") {
+  const auto nodes22 = write_text("huge22", cube22("1000000000"));
+  CHECK_THROWS_WITH(load_mesh(nodes22),
+                    contains_text("declares 1000000000 nodes, more than the file can hold") &&
+                        contains_text("room for at most"));
+  CHECK_THROWS_WITH(load_mesh(write_text("huge41", beam_claiming_a_billion("$Nodes\n"))),
+                    contains_text("$Nodes section declares 1000000000 nodes"));
+  CHECK_THROWS_WITH(load_mesh(write_text("hugeel41", beam_claiming_a_billion("$Elements\n"))),
+                    contains_text("$Elements section declares 1000000000 elements"));
+  std::string elements22 = cube22();
+  elements22.replace(elements22.find("\n6\n"), 3, "\n1000000000\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("hugeel22", elements22)),
+                    contains_text("$Elements section declares 1000000000 elements"));
+  std::string word22 = cube22();
+  word22.replace(word22.find("\n6\n"), 3, "\n1e9\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("word22", word22)),
+                    contains_text("'1e9' is not the section's header"));
+}
+
+TEST_CASE("a cut file is refused naming the section it ends inside or after", "[mesh]") {
+  const std::string cube = cube22();
+  CHECK_THROWS_WITH(load_mesh(write_text("cut22_nodes", cube.substr(0, cube.find("7 0 1 1")))),
+                    contains_text("the file ends inside section $Nodes"));
+  CHECK_THROWS_WITH(load_mesh(write_text("cut22_after", cube.substr(0, cube.find("$Elements")))),
+                    contains_text("the file ends after section $Nodes, with no $Elements"));
+  CHECK_THROWS_WITH(load_mesh(write_text("cut22_elements", cube.substr(0, cube.size() - 14))),
+                    contains_text("the file ends inside section $Elements"));
+  const std::string beam = read_text(test::mesh_path("test_beam.msh"));
+  const auto end_nodes = beam.find("$EndNodes\n") + 10;
+  CHECK_THROWS_WITH(load_mesh(write_text("cut41_after", beam.substr(0, end_nodes))),
+                    contains_text("the file ends after section $Nodes, with no $Elements"));
+  CHECK_THROWS_WITH(load_mesh(write_text("cut41_nodes", beam.substr(0, end_nodes - 200))),
+                    contains_text("the file ends inside section $Nodes (after "));
+}
+
+TEST_CASE("a node without its coordinates, a second $Elements section are refused", "[mesh]") {
+  std::string no_z = cube22();
+  no_z.replace(no_z.find("\n3 0 1 0\n"), 9, "\n3 0 1\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("no_z", no_z)),
+                    contains_text("line 8: '3 0 1' is not a node (tag x y z)"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("no_z41", edited_beam("$Nodes", "\n0 0 0.1\n", "\n0 0\n"))),
+      contains_text("'0 0' is not a node's x y z"));
+  const std::string cube = cube22();
+  const std::string twice = cube + cube.substr(cube.find("$Elements"));
+  CHECK_THROWS_WITH(load_mesh(write_text("elements_twice", twice)),
+                    contains_text("a second $Elements section"));
+}
+
+TEST_CASE("two tetrahedra on the same four nodes are refused, by the file's tags", "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh(write_msh("tet_twice", kUnitTet, {{4, "1 2 3 4"}, {4, "2 1 4 3"}})),
+                    contains_text("tetrahedron 1 (element tag in the file) and tetrahedron 2 "
+                                  "(element tag in the file) have the same four nodes"));
+}
+
+TEST_CASE("the counts of $PhysicalNames and of data sections are held against the file too",
+          "[mesh]") {
+  const std::string cube = cube22();
+  const std::string head = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n";
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("names_huge", head +
+                                             "$PhysicalNames\n1000000000\n3 1 \"body\"\n"
+                                             "$EndPhysicalNames\n" +
+                                             cube.substr(head.size()))),
+      contains_text("$PhysicalNames section declares 1000000000 names"));
+  const std::string data = "$NodeData\n1\n\"d\"\n1\n0.0\n3\n0\n1\n";
+  std::string entries;
+  for (int i = 1; i <= 8; ++i) entries += std::to_string(i) + " 0.5\n";
+  CHECK(load_mesh(write_text("data_ok", cube + data + "8\n" + entries + "$EndNodeData\n"))
+            .num_tets() == 6);
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("data_huge", cube + data + "1000000000\n1 0.5\n$EndNodeData\n")),
+      contains_text("$NodeData section declares 1000000000 entries"));
+}
+
+TEST_CASE("an element line short of a node, a node tag 0, a byte-order mark are named", "[mesh]") {
+  // gmsh read the tetrahedron one node short together with the next line, as a prism.
+  CHECK_THROWS_WITH(
+      load_mesh(write_msh("tet_short", kUnitTet, {{4, "1 2 3"}, {4, "1 2 3 4"}})),
+      contains_text("element '1 4 2 0 1 1 2 3' of gmsh type 4 lists 3 nodes, not its 4"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text(
+          "tet_short41", edited_beam("$Elements", "\n1 106 162 151 138 \n", "\n1 106 162 151\n"))),
+      contains_text("'1 106 162 151' of gmsh type 4 lists 3 nodes, not its 4"));
+  std::string tag0 = cube22();
+  tag0.replace(tag0.find("\n1 0 0 0\n"), 9, "\n0 0 0 0\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("tag0", tag0)),
+                    contains_text("node tag 0 (gmsh numbers nodes from 1)"));
+  CHECK_THROWS_WITH(load_mesh(write_text("bom", "\xEF\xBB\xBF" + cube22())),
+                    contains_text("byte-order mark"));
+}
+
+TEST_CASE("a path that names no mesh file is refused as what it is", "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh(""), contains_text("an empty path names no file"));
+  CHECK_THROWS_WITH(load_mesh(std::filesystem::temp_directory_path().string()),
+                    contains_text("is a directory"));
+  CHECK_THROWS_WITH(load_mesh("/dev/null"), contains_text("is not a regular file"));
+  CHECK_THROWS_WITH(load_mesh(write_text("empty", "")), contains_text("the file is empty"));
+  CHECK_THROWS_WITH(load_mesh(write_text("geo", "Point(1) = {0, 0, 0};\n")),
+                    contains_text("not a gmsh .msh file"));
+  CHECK_THROWS_WITH(load_mesh(write_text("binary", edited_beam("", "4.1 0 8", "4.1 1 8"))),
+                    contains_text("a binary .msh file"));
+  CHECK_THROWS_WITH(load_mesh(write_text("v40", edited_beam("", "4.1 0 8", "4 0 8"))),
+                    contains_text("MSH version 4: the programs read MSH 4.1 and 2.2"));
 }

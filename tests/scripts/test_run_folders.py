@@ -4,7 +4,8 @@
 fem_bench and fem_sim into a folder another run is writing are refused before any work,
 naming it; --replace replaces a finished run only and says so only then; a write that fails
 (FEM_FAIL_WRITES, a full disk injected) exits non-zero with the path and the cause and
-leaves the folder byte-identical; Ctrl-C keeps the frames so far and names them; fem_viewer checks its output files before the work; a run of more than a minute says how long before it goes on,
+leaves the folder byte-identical; Ctrl-C keeps fem_sim's frames so far and names them, and
+stops fem_bench with its folder as it was; fem_viewer checks its output files before the work; a run of more than a minute says how long before it goes on,
 and its lines reach a file. Prints 'N passed, M failed' last.
 
     test_run_folders.py --bench build/release/fem_bench --sim build/release/fem_sim"""
@@ -95,6 +96,24 @@ def bench_cases(bench, tmp):
           p.stdout + p.stderr)
     check("fem_bench: no temporary or lock file left", sorted(snapshot(folder)) == ["bench.json"],
           sorted(snapshot(folder)))
+    bench_interrupted_case(base, folder, tmp)
+
+
+def bench_interrupted_case(base, folder, tmp):
+    """Ctrl-C during --replace: the run stops after its step with a message, exit 130, the
+    earlier bench.json byte-identical and no lock file left (it died silently, its lock left)."""
+    before = snapshot(folder)
+    with open(tmp / "bench_interrupted.log", "w") as log:
+        p = holder(base + ["--steps", "1000000", "--out", folder, "--replace"], log)
+        started = wait_for(tmp / "bench_interrupted.log", "steps of each in turn")
+        p.send_signal(signal.SIGINT)
+        code = p.wait(timeout=120)
+    text = (tmp / "bench_interrupted.log").read_text()
+    check("fem_bench: Ctrl-C during --replace stops with a message, exit 130",
+          started and code == 130 and "stopped (Ctrl-C or SIGTERM) before the results" in text
+          and "is as it was" in text, f"exit {code}: {text}")
+    check("fem_bench: ... the earlier run byte-identical, the lock released",
+          snapshot(folder) == before, sorted(snapshot(folder)))
 
 
 def sim_cases(sim, tmp):

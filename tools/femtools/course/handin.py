@@ -159,12 +159,17 @@ def check_plots(check, folder):
 
 def main(argv=None, prog=None):
     parser = command_parser(prog, __doc__)
-    parser.add_argument("folder", type=pathlib.Path, help="the run's folder handed in (bench.json, plots)")
+    parser.add_argument("folder", help="the run's folder handed in (bench.json, plots)")
     parser.add_argument("--variant", action="append", default=[], help="the variant to check (default: every variant the run measured)")
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build" / "release", help="the build whose tests run")
     parser.add_argument("--no-tests", action="store_true", help="skip the variant's tests")
     add_root_option(parser, hidden=True)
     args = parser.parse_args(argv)
+    # An empty name is no folder: as a path it named the working directory (the repository,
+    # whose .venv links were then reported as the hand-in's).
+    if not args.folder:
+        refuse("an empty folder name: give the hand-in's folder (a run's folder)")
+    args.folder = pathlib.Path(args.folder)
     json_path = args.folder / "bench.json"
     refuse_links(args.folder)
     if not json_path.is_file():

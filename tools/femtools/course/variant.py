@@ -13,7 +13,9 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 
-NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+# fullmatch, not match with $: $ also matches before a final newline, and a name ending in one
+# made a folder that broke every later build (build.ninja cannot hold a newline).
+NAME = re.compile(r"[a-z][a-z0-9_]*")
 
 
 class VariantError(Exception):
@@ -56,7 +58,7 @@ def readme_heading(text, original, variant):
 
 
 def make_variant(root, number, name):
-    if not NAME.match(name):
+    if not NAME.fullmatch(name):
         raise VariantError(f"'{name}' is not a variant name: lower-case letters, digits and _, "
                            "starting with a letter")
     chapters = root / "chapters"
