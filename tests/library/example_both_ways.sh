@@ -68,7 +68,10 @@ compare() {  # NAME
 for way in $ways; do
   case $way in
     installed) build_example installed "-DCMAKE_PREFIX_PATH=$work/prefix" ;;
-    subdirectory) build_example subdirectory "-DFEMCOURSE_SOURCE_DIR=$repo" ;;
+    # The library compiles for the instruction set of the build it is compared with (a
+    # subdirectory is portable by default; another -march rounds differently, ~1e-11 m here).
+    subdirectory) build_example subdirectory "-DFEMCOURSE_SOURCE_DIR=$repo" \
+      "-DFEM_NATIVE=$(sed -n 's/^FEM_NATIVE:BOOL=//p' "$build/CMakeCache.txt")" ;;
     *) echo "unknown way '$way' (installed, subdirectory)" >&2 && exit 2 ;;
   esac
   compare "$way"
