@@ -126,7 +126,8 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
-const char* help_notice = nullptr;  // constant-initialized: set before any use
+// help_notice is defined in common/mesh.cpp, beside the mesh code: the gmsh reader sets it, and
+// links in programs without the command line (the library, femcourse::mesh_gmsh).
 
 std::vector<std::string> ArgParser::get_list(const std::string& name) const {
   std::vector<std::string> items;

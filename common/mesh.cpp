@@ -7,6 +7,12 @@
 #include <map>
 
 namespace fem {
+
+// Declared in common/cli.hpp (the last line of --help); defined here, with the mesh code, so that
+// the gmsh reader that sets it links without the course's command line (femcourse::mesh_gmsh).
+extern const char* help_notice;
+const char* help_notice = nullptr;  // constant-initialized: set before any use
+
 namespace {
 
 [[noreturn]] void fail(const std::string& file, const std::string& problem) {

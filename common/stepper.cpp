@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -33,6 +34,10 @@ void Stepper::set_external_forces(const std::vector<ExternalForce>& forces) {
     for (int r = 0; r < 3; ++r) f_ext_.coeffRef(3 * e.node + r) += e.force[r];
 }
 
+void Stepper::set_constraints(const std::vector<NodeConstraint>& /*constraints*/) {
+  throw std::logic_error("this chapter's stepper cannot change its constraints while it runs");
+}
+
 namespace {
 
 // A single-threaded chapter's stepper, stepped on one thread. Everything else is passed on.
@@ -56,6 +61,10 @@ class OneThreadStepper final : public Stepper {
   }
   const Eigen::SparseVector<double>& external_forces() const override {
     return inner_->external_forces();
+  }
+  bool can_change_constraints() const override { return inner_->can_change_constraints(); }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    inner_->set_constraints(constraints);
   }
   const Stepper& inner() const { return *inner_; }
 
@@ -86,19 +95,44 @@ void Stepper::describe(std::ostream& out) const {
   out << "one stepper class: every phase in its own step()\n";
 }
 
+namespace {
+thread_local WarningSinkScope::Sink current_sink = nullptr;
+thread_local void* current_context = nullptr;
+}  // namespace
+
+WarningSinkScope::WarningSinkScope(Sink sink, void* context)
+    : previous_sink_(current_sink), previous_context_(current_context) {
+  current_sink = sink;
+  current_context = context;
+}
+
+WarningSinkScope::~WarningSinkScope() {
+  current_sink = previous_sink_;
+  current_context = previous_context_;
+}
+
+void warn(const std::string& message) {
+  if (current_sink)
+    current_sink(current_context, message);
+  else
+    std::cerr << "warning: " << message << "\n";
+}
+
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
                              const char* chapter, bool& already_warned) {
   if (profile.converged || already_warned) return;
   already_warned = true;
-  std::cerr << "warning: " << (*chapter ? chapter : "stepper") << ": ";
+  std::ostringstream message;
+  message << (*chapter ? chapter : "stepper") << ": ";
   if (std::isfinite(profile.relative_residual))
-    std::cerr << "the linear solve stopped at the iteration cap (" << settings.max_iterations
-              << ") with relative residual " << profile.relative_residual << " > tolerance "
-              << settings.tolerance;
+    message << "the linear solve stopped at the iteration cap (" << settings.max_iterations
+            << ") with relative residual " << profile.relative_residual << " > tolerance "
+            << settings.tolerance;
   else
-    std::cerr << "the linear solve broke down after " << profile.cg_iterations
-              << " iterations (non-finite residual)";
-  std::cerr << " (reported once; see StepProfile::converged for every step)\n";
+    message << "the linear solve broke down after " << profile.cg_iterations
+            << " iterations (non-finite residual)";
+  message << " (reported once; see StepProfile::converged for every step)";
+  warn(message.str());
 }
 
 const char* divergence(const State& state, const StepProfile& profile) {
@@ -110,7 +144,7 @@ const char* divergence(const State& state, const StepProfile& profile) {
   // at its iteration cap). Below 1 a capped solve is an inexact step: warned and counted.
   if (!profile.converged && profile.relative_residual > 1.0)
     return "the linear solve did not converge: at the iteration cap its relative residual is "
-           "above 1, worse than no solve (a near-incompressible nu? raise --max-iters)";
+           "above 1, worse than no solve (a near-incompressible nu, or too few iterations allowed)";
   return nullptr;
 }
 

@@ -119,6 +119,13 @@ class Stepper {
   virtual void set_name(const std::string& name) { name_ = name; }
   const std::string& name() const { return name_; }
 
+  // Replaces the scene's constraints from the next step on (a grab, a release, a floor's
+  // contacts: femcourse::Body). Only a stepper that says can_change_constraints() does so; the
+  // others were built around their constraints (the filter's pattern, the preconditioner) and
+  // throw std::logic_error, and the library rebuilds them from the scene instead.
+  virtual bool can_change_constraints() const { return false; }
+  virtual void set_constraints(const std::vector<NodeConstraint>& constraints);
+
  protected:
   explicit Stepper(const Scene& scene);
 
@@ -183,8 +190,26 @@ class PhaseTimer {
 
 namespace fem {
 
-// Prints one warning the first time a stepper's solve stops at the iteration cap, so
-// that non-convergence is never silent and never floods the output.
+// Where the steppers' warnings go: std::cerr, unless the thread that steps has a sink in
+// scope (the library hands them to its caller: femcourse::Body's warning handler). Per
+// thread, so that two bodies stepped from two threads keep their own.
+class WarningSinkScope {
+ public:
+  using Sink = void (*)(void* context, const std::string& message);
+  WarningSinkScope(Sink sink, void* context);
+  ~WarningSinkScope();
+  WarningSinkScope(const WarningSinkScope&) = delete;
+  WarningSinkScope& operator=(const WarningSinkScope&) = delete;
+
+ private:
+  Sink previous_sink_;
+  void* previous_context_;
+};
+// Sends one warning (a line, without "warning: " and newline) to the sink in scope.
+void warn(const std::string& message);
+
+// Warns once the first time a stepper's solve stops at the iteration cap, so that
+// non-convergence is never silent and never floods the output.
 void report_if_not_converged(const StepProfile& profile, const SolverSettings& settings,
                              const char* chapter, bool& already_warned);
 

@@ -3,8 +3,7 @@
 #include <Eigen/Core>
 #include <cstdlib>
 #include <stdexcept>
-
-#include "common/build_info.hpp"
+#include <thread>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -40,7 +39,7 @@ void set_threads(int n) {
 }
 
 int thread_limit() {
-  const int hardware = static_cast<int>(hardware_threads());
+  const int hardware = static_cast<int>(std::thread::hardware_concurrency());
   return kOversubscription * (hardware > 0 ? hardware : 1);
 }
 
@@ -49,7 +48,7 @@ std::string check_thread_count(int n) {
   if (n > 1 && !openmp_enabled())
     throw std::invalid_argument("this build has no OpenMP (FEM_OPENMP=OFF): only 1 thread, not " +
                                 std::to_string(n));
-  const unsigned hardware = hardware_threads();
+  const unsigned hardware = std::thread::hardware_concurrency();
   if (n > thread_limit())
     throw std::invalid_argument(
         std::to_string(n) + " threads on a machine with " + std::to_string(hardware) +

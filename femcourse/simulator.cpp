@@ -1,16 +1,22 @@
 #include "femcourse/simulator.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
 #include <utility>
 
 #include "chapters/registry.hpp"
+#include "common/deformation.hpp"
 #include "common/mesh.hpp"
+#include "common/model.hpp"
 #include "common/scene.hpp"
 #include "common/stepper.hpp"
+#include "common/threads.hpp"
 
 namespace femcourse {
+inline namespace FEMCOURSE_ABI {
 namespace {
 
 [[noreturn]] void refuse(const std::string& problem) {
@@ -122,37 +128,218 @@ const fem::ChapterInfo& chapter_of(const std::string& name) {
   return name.empty() ? fem::latest_chapter() : fem::find_chapter(name);
 }
 
+void check_node(int node, int num_nodes, const char* what) {
+  if (node < 0 || node >= num_nodes)
+    refuse(std::string(what) + " names " + node_name(node) + ", which does not exist (" +
+           std::to_string(num_nodes) + " nodes)");
+}
+
+void check_threads(int threads) {
+  if (threads < 0) refuse("threads is " + std::to_string(threads) + ": 0 (automatic) or more");
+  if (threads > 1 && !fem::openmp_enabled())
+    refuse("threads is " + std::to_string(threads) + ", but the library has no OpenMP: 0 or 1");
+  if (threads > 1) fem::check_thread_count(threads);  // throws above the sane limit
+}
+
+// What to change when a step diverged, by its reason (fem::divergence), in the API's terms.
+std::string advice_for(const std::string& reason) {
+  if (reason.find("did not converge") != std::string::npos)
+    return "raise solver_max_iterations, keep poisson_ratio further from 0.5, or shorten "
+           "time_step";
+  if (reason.find("residual is not finite") != std::string::npos)
+    return "the system overflows: check youngs_modulus, the damping and time_step for "
+           "absurd values";
+  return "shorten time_step, or check youngs_modulus, density, the damping and the forces "
+         "for absurd values";
+}
+
+// The thread count of one step, set on the thread that steps (OpenMP's count is per thread),
+// and that thread's own count restored after.
+class StepThreads {
+ public:
+  explicit StepThreads(int threads) : previous_(fem::max_threads()), set_(threads > 0) {
+    if (set_) fem::set_threads(threads);
+  }
+  ~StepThreads() {
+    if (set_) fem::set_threads(previous_);
+  }
+  StepThreads(const StepThreads&) = delete;
+  StepThreads& operator=(const StepThreads&) = delete;
+
+ private:
+  int previous_;
+  bool set_;
+};
+
+constexpr std::size_t kKeptWarnings = 64;
+
 }  // namespace
 
-StepDiverged::StepDiverged(long long k, const std::string& why)
-    : std::runtime_error("the simulation diverged at step " + std::to_string(k) + " (" + why +
-                         "); try a smaller time step"),
+StepDiverged::StepDiverged(long long k, const std::string& why, const std::string& advice)
+    : std::runtime_error("femcourse::Body: the simulation diverged at step " + std::to_string(k) +
+                         " (" + why + "): " + advice),
       step(k),
       reason(why) {}
 
 struct Body::Impl {
   fem::Scene scene;  // first: the stepper is built from it and may keep a reference
+  StepperFactory make;
   std::unique_ptr<fem::Stepper> stepper;
   fem::State state;
+  Eigen::VectorXd previous_v;  // before the last step: the reactions' dv
   fem::SolverSettings solver;
   std::vector<fem::ExternalForce> forces;  // reused: set_forces allocates once
   bool forces_set = false;                 // set_forces was called: forces replace the scene's
   StepProfile profile;
   std::string chapter;
   long long steps = 0;
+  int threads = 0;  // as asked: 0 automatic
+  // The constraints are composed from three sources (compose_constraints).
+  std::vector<fem::NodeConstraint> own;  // the description's, for the body's life
+  std::vector<int> grabbed;
+  Eigen::Vector3d grab_velocity = Eigen::Vector3d::Zero();
+  bool floor_on = false;
+  Eigen::Vector3d floor_point = Eigen::Vector3d::Zero(), floor_normal = Eigen::Vector3d::UnitZ();
+  std::vector<int> contacts;
+  std::vector<char> owned;  // per node: has a constraint of its own
+  std::vector<std::array<int, 3>> surface;
+  // The forces' model, made on first need (reactions, the floor, elastic_forces).
+  mutable std::unique_ptr<fem::Model> model;
+  mutable std::vector<Eigen::Matrix3d> rotations;
+  mutable Eigen::VectorXd f_model;
+  mutable std::unique_ptr<fem::DeformationProbe> probe;
+  std::function<void(const std::string&)> warning_handler;
+  std::deque<std::string> warnings;
 
-  Impl(fem::Scene s, const StepperFactory& make, const fem::SolverSettings& settings,
-       std::string id)
-      : scene(std::move(s)), solver(settings), chapter(std::move(id)) {
+  Impl(fem::Scene s, StepperFactory factory, const fem::SolverSettings& settings, std::string id)
+      : scene(std::move(s)), make(std::move(factory)), solver(settings), chapter(std::move(id)) {
+    own = scene.constraints;
+    owned.assign(static_cast<std::size_t>(scene.mesh.num_nodes()), 0);
+    for (const fem::NodeConstraint& c : own) owned[static_cast<std::size_t>(c.node)] = 1;
+    for (const Eigen::Vector3i& t : scene.mesh.boundary) surface.push_back({t[0], t[1], t[2]});
     stepper = make(scene, solver);
     state = fem::rest_state(scene);
+    previous_v = state.v;
   }
+
+  const std::vector<fem::ExternalForce>& current_forces() const {
+    return forces_set ? forces : scene.external_forces;
+  }
+  bool is_grabbed(int node) const {
+    return std::find(grabbed.begin(), grabbed.end(), node) != grabbed.end();
+  }
+  std::vector<fem::NodeConstraint> compose_constraints() const;
+  void apply_constraints(std::vector<fem::NodeConstraint> constraints);
+  void restart_stepper() { apply_constraints(scene.constraints); }
+  void replace_contacts(std::vector<int> next);
+  const Eigen::VectorXd& model_forces() const;  // elastic + gravity at state.x
+  Eigen::Vector3d reaction(int node) const;
+  void update_floor();
+  static void receive_warning(void* self, const std::string& message);
 };
+
+std::vector<fem::NodeConstraint> Body::Impl::compose_constraints() const {
+  std::vector<fem::NodeConstraint> all;
+  for (const fem::NodeConstraint& c : own)
+    if (!is_grabbed(c.node)) all.push_back(c);
+  for (const int node : grabbed) all.push_back(fem::NodeConstraint::fixed(node, grab_velocity));
+  for (const int node : contacts) all.push_back(fem::NodeConstraint::plane(node, floor_normal));
+  return all;
+}
+
+// In place when the stepper can; else a new stepper from the scene (the slow path). Either
+// way a throw leaves the scene's constraints and the stepper as they were.
+void Body::Impl::apply_constraints(std::vector<fem::NodeConstraint> constraints) {
+  if (stepper->can_change_constraints()) {
+    stepper->set_constraints(constraints);
+    scene.constraints = std::move(constraints);
+    return;
+  }
+  std::swap(scene.constraints, constraints);
+  try {
+    std::unique_ptr<fem::Stepper> rebuilt = make(scene, solver);
+    rebuilt->set_external_forces(current_forces());
+    stepper = std::move(rebuilt);
+  } catch (...) {
+    std::swap(scene.constraints, constraints);
+    throw;
+  }
+}
+
+// The floor's contacts, and the constraints with them; a throw leaves both as they were.
+void Body::Impl::replace_contacts(std::vector<int> next) {
+  std::swap(contacts, next);
+  try {
+    apply_constraints(compose_constraints());
+  } catch (...) {
+    std::swap(contacts, next);
+    throw;
+  }
+}
+
+const Eigen::VectorXd& Body::Impl::model_forces() const {
+  if (!model) {
+    model = std::make_unique<fem::Model>(scene);
+    rotations.resize(scene.mesh.tets.size());
+    f_model.resize(model->dofs);
+  }
+  fem::compute_rotations_and_forces(*model, state.x, rotations, f_model);
+  return f_model;
+}
+
+// m dv/dt - f(x) - f_ext + alpha m v: what the constraint added to the node's momentum.
+// model_forces() must be current.
+Eigen::Vector3d Body::Impl::reaction(int node) const {
+  const Eigen::Index i = 3 * node;
+  const Eigen::Vector3d m = model->lumped_mass.segment<3>(i);
+  const Eigen::Vector3d v = state.v.segment<3>(i);
+  const Eigen::Vector3d dv = v - previous_v.segment<3>(i);
+  Eigen::Vector3d f_ext = Eigen::Vector3d::Zero();
+  for (int r = 0; r < 3; ++r) f_ext[r] = stepper->external_forces().coeff(i + r);
+  return m.cwiseProduct(dv) / scene.dt - f_model.segment<3>(i) - f_ext +
+         scene.damping.alpha * m.cwiseProduct(v);
+}
+
+// The floor's active set after a step: contacts whose floor pulls are let go, free nodes
+// below it are put on it with their velocity into it removed.
+void Body::Impl::update_floor() {
+  if (!floor_on) return;
+  bool changed = false;
+  if (!contacts.empty()) {
+    model_forces();
+    const auto pulling = [&](int node) { return reaction(node).dot(floor_normal) < 0.0; };
+    const auto end = std::remove_if(contacts.begin(), contacts.end(), pulling);
+    changed = end != contacts.end();
+    contacts.erase(end, contacts.end());
+  }
+  for (int node = 0; node < scene.mesh.num_nodes(); ++node) {
+    const auto n = static_cast<std::size_t>(node);
+    auto x = state.x.segment<3>(3 * node);
+    const double depth = floor_normal.dot(x - floor_point);
+    if (depth >= 0.0 || owned[n] || is_grabbed(node) ||
+        std::find(contacts.begin(), contacts.end(), node) != contacts.end())
+      continue;
+    x -= depth * floor_normal;
+    auto v = state.v.segment<3>(3 * node);
+    v -= std::min(0.0, floor_normal.dot(v)) * floor_normal;
+    contacts.push_back(node);
+    changed = true;
+  }
+  if (changed) apply_constraints(compose_constraints());
+}
+
+void Body::Impl::receive_warning(void* self, const std::string& message) {
+  Impl& b = *static_cast<Impl*>(self);
+  if (b.warning_handler) return b.warning_handler(message);
+  if (b.warnings.size() == kKeptWarnings) b.warnings.pop_front();
+  b.warnings.push_back(message);
+}
 
 Body::Body(const BodyDescription& d) : Body(d, StepperFactory{}) {}
 
 Body::Body(const BodyDescription& d, const StepperFactory& make_stepper) {
   const fem::SolverSettings solver = solver_of(d);
+  check_threads(d.threads);
   fem::Scene scene = scene_of(d, mesh_of(d));
   if (make_stepper) {
     impl_ = std::make_unique<Impl>(std::move(scene), make_stepper, solver, "custom");
@@ -160,6 +347,7 @@ Body::Body(const BodyDescription& d, const StepperFactory& make_stepper) {
     const fem::ChapterInfo& info = chapter_of(d.chapter);
     impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
   }
+  impl_->threads = d.threads;
 }
 
 Body::Body(fem::Scene scene, const fem::SolverSettings& solver, const std::string& chapter) {
@@ -172,29 +360,51 @@ Body::~Body() = default;
 Body::Body(Body&&) noexcept = default;
 Body& Body::operator=(Body&&) noexcept = default;
 
+Body::Impl& Body::impl() { return const_cast<Impl&>(static_cast<const Body&>(*this).impl()); }
+
+const Body::Impl& Body::impl() const {
+  if (!impl_)
+    throw std::logic_error(
+        "femcourse::Body: this body was moved from: assign a Body to it "
+        "before using it");
+  return *impl_;
+}
+
 void Body::step() {
-  Impl& b = *impl_;
-  b.stepper->step(b.state);
+  Impl& b = impl();
+  b.previous_v = b.state.v;
+  {
+    const StepThreads team(b.threads > 0 ? b.threads : num_nodes() < kSmallBodyNodes ? 1 : 0);
+    const fem::WarningSinkScope sink(&Impl::receive_warning, &b);
+    b.stepper->step(b.state);
+  }
   ++b.steps;
   const fem::StepProfile& p = b.stepper->profile();
   b.profile = {p.forces.seconds,    p.dfdx.seconds, p.compose.seconds,  p.constraints.seconds,
                p.solve.seconds,     p.step.seconds, p.step.allocations, p.cg_iterations,
                p.relative_residual, p.converged};
-  if (const char* why = fem::divergence(b.state, p)) throw StepDiverged(b.steps, why);
+  if (const char* why = fem::divergence(b.state, p))
+    throw StepDiverged(b.steps, why, advice_for(why));
+  b.update_floor();
 }
 
 void Body::set_forces(const std::vector<NodeForce>& forces) {
-  Impl& b = *impl_;
+  Impl& b = impl();
+  for (const NodeForce& f : forces) {  // first, so that a refused list changes nothing
+    check_node(f.node, num_nodes(), "set_forces");
+    if (!vector_of(f.force).allFinite())
+      refuse("set_forces: the force on " + node_name(f.node) + " is not finite");
+  }
   b.forces.clear();  // keeps the capacity
   for (const NodeForce& f : forces) b.forces.push_back({f.node, vector_of(f.force)});
   b.stepper->set_external_forces(b.forces);
   b.forces_set = true;
 }
 
-int Body::num_nodes() const { return impl_->scene.mesh.num_nodes(); }
-int Body::num_tetrahedra() const { return impl_->scene.mesh.num_tets(); }
-const double* Body::positions() const { return impl_->state.x.data(); }
-const double* Body::velocities() const { return impl_->state.v.data(); }
+int Body::num_nodes() const { return impl().scene.mesh.num_nodes(); }
+int Body::num_tetrahedra() const { return impl().scene.mesh.num_tets(); }
+const double* Body::positions() const { return impl().state.x.data(); }
+const double* Body::velocities() const { return impl().state.v.data(); }
 
 std::array<double, 3> Body::position(int node) const {
   if (node < 0 || node >= num_nodes())
@@ -203,28 +413,158 @@ std::array<double, 3> Body::position(int node) const {
   return {x[0], x[1], x[2]};
 }
 
-double Body::time() const { return static_cast<double>(impl_->steps) * impl_->scene.dt; }
-const StepProfile& Body::profile() const { return impl_->profile; }
-const std::string& Body::chapter() const { return impl_->chapter; }
+double Body::time() const { return static_cast<double>(impl().steps) * impl().scene.dt; }
+const StepProfile& Body::profile() const { return impl().profile; }
+const std::string& Body::chapter() const { return impl().chapter; }
+
 void Body::set_chapter(const std::string& chapter) {
+  Impl& b = impl();
   const fem::ChapterInfo& info = chapter_of(chapter);
-  impl_->stepper = info.make(impl_->scene, impl_->solver);
-  impl_->stepper->set_external_forces(impl_->forces_set ? impl_->forces
-                                                        : impl_->scene.external_forces);
-  impl_->chapter = info.id;
+  std::unique_ptr<fem::Stepper> next = info.make(b.scene, b.solver);
+  next->set_external_forces(b.current_forces());
+  // Nothing above changed the body: from here on nothing throws.
+  b.stepper = std::move(next);
+  b.make = info.make;
+  b.chapter = info.id;
+}
+
+int Body::threads() const { return impl().threads; }
+
+void Body::set_threads(int threads) {
+  Impl& b = impl();
+  check_threads(threads);
+  b.threads = threads;
+}
+
+void Body::grab(const std::vector<int>& nodes, const std::array<double, 3>& velocity) {
+  Impl& b = impl();
+  for (const int node : nodes) check_node(node, num_nodes(), "grab");
+  if (!vector_of(velocity).allFinite()) refuse("grab: the velocity is not finite");
+  std::vector<int> grabbed = nodes;
+  std::sort(grabbed.begin(), grabbed.end());
+  grabbed.erase(std::unique(grabbed.begin(), grabbed.end()), grabbed.end());
+  std::vector<int> contacts = b.contacts;  // a grabbed node leaves the floor
+  contacts.erase(
+      std::remove_if(contacts.begin(), contacts.end(),
+                     [&](int n) { return std::binary_search(grabbed.begin(), grabbed.end(), n); }),
+      contacts.end());
+  std::swap(b.grabbed, grabbed);
+  std::swap(b.contacts, contacts);
+  const Eigen::Vector3d previous_velocity = b.grab_velocity;
+  b.grab_velocity = vector_of(velocity);
+  try {
+    b.apply_constraints(b.compose_constraints());
+  } catch (...) {
+    std::swap(b.grabbed, grabbed);
+    std::swap(b.contacts, contacts);
+    b.grab_velocity = previous_velocity;
+    throw;
+  }
+}
+
+void Body::move_grabbed(const std::array<double, 3>& velocity) {
+  Impl& b = impl();
+  grab(std::vector<int>(b.grabbed), velocity);
+}
+
+void Body::release() { grab({}); }
+const std::vector<int>& Body::grabbed() const { return impl().grabbed; }
+
+void Body::set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal) {
+  Impl& b = impl();
+  const Eigen::Vector3d p = vector_of(point), n = vector_of(normal);
+  if (!p.allFinite() || !n.allFinite() || !(n.norm() > 0.0))
+    refuse("set_floor: the point and the normal must be finite, the normal not zero");
+  b.floor_on = true;
+  b.floor_point = p;
+  b.floor_normal = n.normalized();
+}
+
+void Body::remove_floor() {
+  Impl& b = impl();
+  b.replace_contacts({});
+  b.floor_on = false;
+}
+
+const std::vector<int>& Body::floor_contacts() const { return impl().contacts; }
+bool Body::changes_constraints_in_place() const { return impl().stepper->can_change_constraints(); }
+const std::vector<std::array<int, 3>>& Body::surface() const { return impl().surface; }
+
+std::vector<NodeForce> Body::reactions() const {
+  const Impl& b = impl();
+  b.model_forces();
+  std::vector<NodeForce> out;
+  for (const fem::NodeConstraint& c : b.scene.constraints) {
+    const Eigen::Vector3d r = b.reaction(c.node);
+    out.push_back({c.node, {r[0], r[1], r[2]}});
+  }
+  return out;
+}
+
+std::vector<double> Body::elastic_forces() const {
+  const Impl& b = impl();
+  const Eigen::VectorXd elastic = b.model_forces() - b.model->gravity_force;
+  return {elastic.data(), elastic.data() + elastic.size()};
+}
+
+DeformationStatus Body::check_deformation() const {
+  const Impl& b = impl();
+  if (!b.probe) b.probe = std::make_unique<fem::DeformationProbe>(b.scene);
+  const fem::DeformationCheck c = b.probe->check(b.state);
+  const fem::DeformationLimits limits;
+  const bool plausible =
+      c.largest_stretch < limits.stretch && c.inverted <= limits.inverted_share * c.elements;
+  return {c.inverted, c.largest_stretch, plausible};
+}
+
+void Body::set_warning_handler(std::function<void(const std::string&)> handler) {
+  impl().warning_handler = std::move(handler);
+}
+
+std::vector<std::string> Body::take_warnings() {
+  Impl& b = impl();
+  std::vector<std::string> out(b.warnings.begin(), b.warnings.end());
+  b.warnings.clear();
+  return out;
+}
+
+BodyState Body::save_state() {
+  Impl& b = impl();
+  b.restart_stepper();
+  const fem::State& s = b.state;
+  return {{s.x.data(), s.x.data() + s.x.size()},
+          {s.v.data(), s.v.data() + s.v.size()},
+          b.steps,
+          b.contacts};
+}
+
+void Body::restore_state(const BodyState& saved) {
+  Impl& b = impl();
+  const auto values = static_cast<std::size_t>(b.state.x.size());
+  if (saved.positions.size() != values || saved.velocities.size() != values)
+    refuse("restore_state: the state holds " + std::to_string(saved.positions.size() / 3) +
+           " nodes, the body " + std::to_string(num_nodes()));
+  for (const int node : saved.floor_contacts)
+    check_node(node, num_nodes(), "restore_state: a floor contact");
+  b.replace_contacts(saved.floor_contacts);
+  b.state.x = Eigen::Map<const Eigen::VectorXd>(saved.positions.data(), b.state.x.size());
+  b.state.v = Eigen::Map<const Eigen::VectorXd>(saved.velocities.data(), b.state.v.size());
+  b.previous_v = b.state.v;
+  b.steps = saved.steps;
 }
 
 void Body::set_state(const fem::State& state) {
-  if (state.x.size() != impl_->state.x.size() || state.v.size() != impl_->state.v.size())
+  Impl& b = impl();
+  if (state.x.size() != b.state.x.size() || state.v.size() != b.state.v.size())
     refuse("set_state: the state has " + std::to_string(state.x.size() / 3) + " nodes, the body " +
            std::to_string(num_nodes()));
-  impl_->state.x = state.x;
-  impl_->state.v = state.v;
+  b.state.x = state.x;
+  b.state.v = state.v;
 }
 
-const fem::Scene& Body::scene() const { return impl_->scene; }
-const fem::State& Body::state() const { return impl_->state; }
-const fem::Stepper& Body::stepper() const { return *impl_->stepper; }
+const fem::Scene& Body::scene() const { return impl().scene; }
+const fem::State& Body::state() const { return impl().state; }
+const fem::Stepper& Body::stepper() const { return *impl().stepper; }
 
 Body body_from_gmsh_file(const std::string& path, const BodyDescription& description) {
   fem::TetMesh mesh = fem::load_mesh(path);  // femcourse::mesh_gmsh, else it throws
@@ -236,4 +576,5 @@ Body body_from_gmsh_file(const std::string& path, const BodyDescription& descrip
   return Body(d);
 }
 
+}  // namespace FEMCOURSE_ABI
 }  // namespace femcourse

@@ -4,14 +4,17 @@
 //
 // Guarantees (tests/library/test_simulator.cpp asserts each):
 //  - step() and set_forces() make no heap allocation once set_forces() has held as many
-//    forces as it is given (step() never does).
+//    forces as it is given (step() never does while the constraints stay as they are).
 //  - The positions are those of the chapter's own stepper on the same scene, bit for bit, and
-//    bit-identical for any OpenMP thread count (OMP_NUM_THREADS, omp_set_num_threads).
-//  - Thread safety: a Body is used by one thread at a time. Its steps run on OpenMP threads
-//    inside; two bodies stepped at the same time from two threads are not supported (the
-//    single-threaded chapters set Eigen's process-wide thread count during their step).
-// Only standard types cross this header, so a program compiled with other flags than the
-// library (another -march) links safely against it.
+//    bit-identical for any thread count.
+//  - A call that throws (other than step()) leaves the body exactly as it was.
+//  - Thread safety: a Body is used by one thread at a time; two bodies may be stepped from two
+//    threads at once (each step sets its own thread count on the thread that steps it).
+//  - Nothing is printed: warnings go to the body's handler, or wait in its queue.
+// Only standard types cross this header (apart from the advanced section at the end), so a
+// program compiled with other flags than the library (another -march, no OpenMP) links safely
+// against it. A standard library of another ABI (libc++, _GLIBCXX_DEBUG, the pre-C++11 string)
+// would lay out BodyDescription differently: such a program does not link (FEMCOURSE_ABI).
 #pragma once
 
 #include <array>
@@ -21,6 +24,19 @@
 #include <string>
 #include <vector>
 
+// The standard library's mode is part of every name below, so that a program built in
+// another mode fails to link, naming it ("undefined reference to femcourse::glibcxx_debug::
+// Body::Body"), instead of reading a BodyDescription of another layout.
+#if defined(_LIBCPP_VERSION)
+#define FEMCOURSE_ABI libcxx
+#elif defined(_GLIBCXX_DEBUG)
+#define FEMCOURSE_ABI glibcxx_debug
+#elif defined(_GLIBCXX_USE_CXX11_ABI) && _GLIBCXX_USE_CXX11_ABI == 0
+#define FEMCOURSE_ABI glibcxx_old_string
+#else
+#define FEMCOURSE_ABI libstdcxx
+#endif
+
 namespace fem {  // the course's own types, for the advanced section at the end
 class Stepper;
 struct Scene;
@@ -29,12 +45,15 @@ struct SolverSettings;
 }  // namespace fem
 
 namespace femcourse {
+inline namespace FEMCOURSE_ABI {
 
-// Per-node velocity constraints: the poster's filters S_i.
+// Per-node velocity constraints, given at construction (grab() and set_floor() add their own
+// while the body runs). Every kind is two-sided: a node on a Plane stays on it however it is
+// pulled (set_floor() is the one-sided floor).
 struct Constraint {
   enum class Kind {
     Fixed,  // does not move (or moves with `velocity`)
-    Plane,  // moves in the plane with normal `direction` (a frictionless floor)
+    Plane,  // moves in the plane through its position with normal `direction`
     Line    // moves along `direction`
   };
   int node = 0;
@@ -65,7 +84,12 @@ struct BodyDescription {
   double solver_tolerance = 1e-4;                  // CG stops at ||r|| <= tolerance ||b||
   int solver_max_iterations = 2000;
   std::string chapter;  // "12_half_the_bytes", "12", "half_the_bytes"; empty: the last chapter
+  // Threads that step this body (chapters 09 on; the earlier ones use one). 0: one thread
+  // below kSmallBodyNodes nodes, where a second thread gains little and another process on
+  // the machine turns each of its waits into a hitch; OpenMP's count above.
+  int threads = 0;
 };
+constexpr int kSmallBodyNodes = 20000;
 
 // What the last step cost, by the poster's phases [s], and how its linear solve went.
 struct StepProfile {
@@ -77,25 +101,43 @@ struct StepProfile {
 };
 
 // Thrown by Body::step for a step that cannot be trusted: non-finite positions or velocities,
-// or a linear solve that overflowed or stopped at its cap worse than no solve at all.
+// or a linear solve that overflowed or stopped at its cap worse than no solve at all. what()
+// says what to change, in BodyDescription's terms.
 struct StepDiverged : std::runtime_error {
-  StepDiverged(long long step, const std::string& reason);
+  StepDiverged(long long step, const std::string& reason, const std::string& advice);
   long long step;      // counted from 1
   std::string reason;  // e.g. "non-finite positions or velocities"
+};
+
+// A saved state: what restore_state() needs to go on exactly as the body went on.
+struct BodyState {
+  std::vector<double> positions, velocities;  // 3 per node
+  long long steps = 0;
+  std::vector<int> floor_contacts;  // nodes held on the floor (set_floor)
+};
+
+// The deformation watch (fem_sim's): an element stretched to several times its rest size, or
+// a share of the body turned inside out, means the run has blown up even with finite numbers
+// (a 1e30 N force, a far too large time step).
+struct DeformationStatus {
+  int inverted_elements = 0;     // det F <= 0
+  double largest_stretch = 1.0;  // max over edges of deformed / rest length
+  bool plausible = true;         // stretch under 5 and under 1% of the elements inverted
 };
 
 class Body {
  public:
   // Throws std::invalid_argument naming the first bad element or node: an index out of range,
   // a zero-volume or inverted tetrahedron, a NaN, a node in no tetrahedron, a constraint on a
-  // missing node, a bad material or time step, an unknown chapter.
+  // missing node, a bad material or time step, an unknown chapter, a bad thread count.
   explicit Body(const BodyDescription& description);
   ~Body();
+  // A moved-from body throws std::logic_error from every call until one is assigned to it.
   Body(Body&&) noexcept;
   Body& operator=(Body&&) noexcept;
 
   // One step of time_step. Throws StepDiverged if the step cannot be trusted; the state is then
-  // that of the failed step.
+  // that of the failed step (restore_state() goes back to a saved one).
   void step();
   // Replaces the external forces (the mouse drag) from the next step on; {} removes them.
   // Throws std::invalid_argument for a missing node or a non-finite force.
@@ -112,9 +154,58 @@ class Body {
   // Steps on with another chapter's stepper from the current state (the viewer's chapter
   // switch); throws std::invalid_argument for an unknown chapter and changes nothing then.
   void set_chapter(const std::string& chapter);
+  int threads() const;
+  void set_threads(int threads);  // as BodyDescription::threads
+
+  // ---- interaction while it runs ---------------------------------------------------------
+  // Each call below changes the body's constraints from the next step on. A chapter's stepper
+  // that can change its constraints does so in place; the others are rebuilt from the scene
+  // with the new constraints (the slow path: a construction's cost, about 3 ms at 320 nodes;
+  // the state, time and forces carry over). changes_constraints_in_place() says which.
+  //
+  // Holds `nodes` (replacing their own constraints until release()) and moves them all with
+  // `velocity` [m/s]. Throws std::invalid_argument for a missing node.
+  void grab(const std::vector<int>& nodes, const std::array<double, 3>& velocity = {});
+  void move_grabbed(const std::array<double, 3>& velocity);
+  void release();  // the grabbed nodes get their own constraints back
+  const std::vector<int>& grabbed() const;
+  // A one-sided, frictionless floor: the plane through `point` with normal `normal` (pointing
+  // to where the body may go). A free node that ends a step below it is put on it, its
+  // velocity into it removed, and held on it until the floor would have to pull it back (its
+  // reaction points into the floor): then it is released. Nodes with constraints of their own
+  // or grabbed are left alone. Throws std::invalid_argument for a zero or non-finite normal.
+  void set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal);
+  void remove_floor();
+  const std::vector<int>& floor_contacts() const;
+  bool changes_constraints_in_place() const;
+
+  // ---- output -----------------------------------------------------------------------------
+  // The boundary triangles (faces of exactly one tetrahedron), outward by the right-hand
+  // rule, as node indices into positions(): what to draw.
+  const std::vector<std::array<int, 3>>& surface() const;
+  // The forces that the constraints (own, grabbed, floor) exerted on their nodes in the last
+  // step [N]: m dv/dt minus the elastic, gravity, external and mass-damping forces at the new
+  // state (the stiffness damping left out). Summed over a support at rest, minus the loads.
+  std::vector<NodeForce> reactions() const;
+  // The elastic forces on every node at the current positions [N], 3 * num_nodes() values.
+  std::vector<double> elastic_forces() const;
+  DeformationStatus check_deformation() const;
+
+  // ---- diagnostics ------------------------------------------------------------------------
+  // Warnings (a solve stopped at its cap) go to the handler, called on the thread that steps;
+  // without one they wait in a queue (the last 64) that take_warnings() empties.
+  void set_warning_handler(std::function<void(const std::string&)> handler);
+  std::vector<std::string> take_warnings();
+  // A state to go back to. Saving restarts the stepper (its warm starts, its refreshed
+  // preconditioner), so that from then on the saved state alone decides every step: a body
+  // restored to it steps bit-identically to the body that saved it. Costs a construction.
+  BodyState save_state();
+  // Throws std::invalid_argument for another number of nodes or a missing contact node.
+  void restore_state(const BodyState& state);
 
   // ---- advanced: the course's own types (include "common/stepper.hpp") -----------------
-  // A stepper of one's own: any fem::Stepper built from the body's scene (docs/library.md).
+  // Inside the source tree only (add_subdirectory): the installed package has no course
+  // headers. A stepper of one's own: any fem::Stepper built from the body's scene.
   using StepperFactory =
       std::function<std::unique_ptr<fem::Stepper>(const fem::Scene&, const fem::SolverSettings&)>;
   Body(const BodyDescription& description, const StepperFactory& make_stepper);
@@ -130,6 +221,8 @@ class Body {
 
  private:
   struct Impl;
+  Impl& impl();
+  const Impl& impl() const;
   std::unique_ptr<Impl> impl_;
 };
 
@@ -137,4 +230,5 @@ class Body {
 // fields used. Needs the femcourse::mesh_gmsh target (gmsh); throws fem::MeshError otherwise.
 Body body_from_gmsh_file(const std::string& path, const BodyDescription& description);
 
+}  // namespace FEMCOURSE_ABI
 }  // namespace femcourse

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "chapters/10_multigrid/report.hpp"
 
 namespace fem::ch10 {
 
@@ -52,15 +51,25 @@ MultigridPreconditioner::MultigridPreconditioner(const ch08::PartSetup& setup, c
                              rest_positions(setup.scene), setup.scene.constraints);
 }
 
+namespace {
+
+// One level's line of the summary: its block rows, stored blocks and their bytes in double.
+template <class Level>
+void describe_level(std::ostream& out, int l, const Level& level) {
+  const int block = Level::block_size;
+  const long long blocks = static_cast<long long>(level.A.column.size());
+  out << "    level " << l << ": " << level.nodes() << " block rows of " << block << "x" << block
+      << ", " << blocks << " blocks, " << blocks * block * block * sizeof(double) / 1024
+      << " KiB of blocks in double\n";
+}
+
+}  // namespace
+
 void MultigridPreconditioner::describe(std::ostream& out) const {
   out << "  multigrid: " << multigrid_.levels() << " levels\n";
-  for (int l = 0; l < multigrid_.levels(); ++l) {
-    const int block = l == 0 ? 3 : kModes;
-    const long long blocks = level_blocks(multigrid_, l);
-    out << "    level " << l << ": " << level_dofs(multigrid_, l) / block << " block rows of "
-        << block << "x" << block << ", " << blocks << " blocks, "
-        << blocks * block * block * sizeof(double) / 1024 << " KiB of blocks in double\n";
-  }
+  describe_level(out, 0, multigrid_.fine_level());
+  for (std::size_t l = 0; l < multigrid_.coarse_levels().size(); ++l)
+    describe_level(out, static_cast<int>(l) + 1, multigrid_.coarse_levels()[l]);
 }
 
 Extrapolation::Extrapolation(const ch08::PartSetup& setup, const Params& params)

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# What `cmake --install` ships (cmake/install.cmake), checked from the outside:
+#  - at most 15 headers, each compiling alone with the standard library only;
+#  - no lesson, report, work-count, JSON, command-line or VTK object in the archives;
+#  - no compile option of ours in the exported targets (OpenMP link-only), the instruction set
+#    recorded in the config;
+#  - a consumer in another standard library mode (-D_GLIBCXX_DEBUG) does not link, naming it,
+#    while the same consumer in the library's mode links and runs.
+# Usage: installed_package.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+build=$1 work=$(realpath -m "$2")
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+rm -rf "$work" && mkdir -p "$work"
+cmake --install "$build" --prefix "$work/prefix" >"$work/install.log"
+compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+mapfile -t headers < <(cd "$work/prefix/include" && find . -name '*.hpp' | sort)
+echo "installed headers: ${#headers[@]} (${headers[*]})"
+((${#headers[@]} >= 1 && ${#headers[@]} <= 15)) || fail "${#headers[@]} headers installed"
+for header in "${headers[@]}"; do
+  echo "#include <${header#./}>" | "$compiler" -std=c++17 -Wall -Wextra -Wpedantic -Werror \
+    -fsyntax-only -I"$work/prefix/include" -x c++ - ||
+    fail "$header does not compile alone"
+done
+
+for archive in "$work"/prefix/lib/*.a; do
+  members=$(ar t "$archive")
+  echo "$(basename "$archive"): $(wc -c <"$archive") bytes, $(wc -l <<<"$members") objects"
+  if grep -E "lesson|report|work|json|cli|machine_|vtk|run_lock|atomic_file|build_info" <<<"$members"; then
+    fail "$(basename "$archive") holds lesson, benchmark or I/O code"
+  fi
+done
+
+targets=$(cat "$work"/prefix/lib/cmake/femcourse/femcourse-targets*.cmake)
+if grep -E "INTERFACE_COMPILE_OPTIONS|fopenmp|march" <<<"$targets"; then
+  fail "the exported targets pass compile options to their consumers"
+fi
+if grep -o '.\{10\}OpenMP::OpenMP_CXX' <<<"$targets" | grep -v 'LINK_ONLY:OpenMP'; then
+  fail "OpenMP is more than a link dependency of the exported targets"
+fi
+grep -o 'set(femcourse_CPU_FLAGS "[^"]*")' "$work/prefix/lib/cmake/femcourse/femcourse-config.cmake" ||
+  fail "the config records no instruction set"
+
+probe() {  # NAME CXX_FLAGS
+  cmake -S "$here/abi_probe" -B "$work/$1" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    ${compiler:+"-DCMAKE_CXX_COMPILER=$compiler"} "-DCMAKE_PREFIX_PATH=$work/prefix" \
+    "-DCMAKE_CXX_FLAGS=$2" >"$work/$1.configure.log"
+  cmake --build "$work/$1" >"$work/$1.build.log" 2>&1
+}
+probe same "" || { cat "$work/same.build.log" >&2; fail "the consumer in the library's mode"; }
+"$work/same/probe"
+grep -q -- "-fopenmp" "$work/same/build.ninja" && fail "-fopenmp reached the consumer's flags"
+if probe debug "-D_GLIBCXX_DEBUG"; then
+  fail "a consumer built with -D_GLIBCXX_DEBUG linked against the library"
+fi
+grep -q "femcourse::glibcxx_debug::Body" "$work/debug.build.log" ||
+  fail "the refused link does not name the mode (femcourse::glibcxx_debug)"
+echo "a -D_GLIBCXX_DEBUG consumer is refused at link time: $(grep -m1 -o 'undefined reference to .femcourse::glibcxx_debug::[^(]*' "$work/debug.build.log")"
+echo "PASS: the installed package"
