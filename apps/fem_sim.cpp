@@ -40,6 +40,7 @@ void add_options(ArgParser& args) {
   args.option("chapter", "NAME", "stepper to use (01_naive, 01, naive, ...)", latest_chapter().id);
   args.option("steps", "N", "number of time steps, > 0", "200");
   args.option("every", "N", "write a frame every N steps (0: no output)", "2");
+  args.flag("verbose", "print what the stepper built: its recipe's parts and their data");
   args.option("watch", "NODE", "print this node's final position, 17 digits (-1: none)", "-1");
   args.option("out", "DIR",
               "directory for the .vtu frames and the .pvd series (an earlier series of the "
@@ -155,6 +156,7 @@ void run_scene(const ArgParser& args, const Run& run) {
   const bool threaded = body.stepper().uses_threads();
   std::cout << "threads: " << (threaded ? run.threads : 1)
             << (threaded ? "" : " (this chapter is single-threaded)") << "\n";
+  if (args.has_flag("verbose")) std::cout << "stepper: " << body.stepper();
   // The new series replaces an earlier one only once it is whole (common/vtk.hpp): a run
   // that fails part-way leaves the earlier series as it was.
   std::optional<VtkSeries> series;

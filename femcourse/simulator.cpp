@@ -230,7 +230,10 @@ struct Body::Impl {
   }
   std::vector<fem::NodeConstraint> compose_constraints() const;
   void apply_constraints(std::vector<fem::NodeConstraint> constraints);
-  void restart_stepper() { apply_constraints(scene.constraints); }
+  // A new stepper from the scene: no history (warm starts, rotations, a lagged hierarchy), so
+  // that a saved state alone decides what follows.
+  void restart_stepper() { rebuild_stepper(); }
+  void rebuild_stepper();
   void replace_contacts(std::vector<int> next);
   const Eigen::VectorXd& model_forces() const;  // elastic + gravity at state.x
   Eigen::Vector3d reaction(int node) const;
@@ -257,13 +260,17 @@ void Body::Impl::apply_constraints(std::vector<fem::NodeConstraint> constraints)
   }
   std::swap(scene.constraints, constraints);
   try {
-    std::unique_ptr<fem::Stepper> rebuilt = make(scene, solver);
-    rebuilt->set_external_forces(current_forces());
-    stepper = std::move(rebuilt);
+    rebuild_stepper();
   } catch (...) {
     std::swap(scene.constraints, constraints);
     throw;
   }
+}
+
+void Body::Impl::rebuild_stepper() {
+  std::unique_ptr<fem::Stepper> rebuilt = make(scene, solver);
+  rebuilt->set_external_forces(current_forces());
+  stepper = std::move(rebuilt);
 }
 
 // The floor's contacts, and the constraints with them; a throw leaves both as they were.
@@ -547,6 +554,7 @@ void Body::restore_state(const BodyState& saved) {
   for (const int node : saved.floor_contacts)
     check_node(node, num_nodes(), "restore_state: a floor contact");
   b.replace_contacts(saved.floor_contacts);
+  b.restart_stepper();  // as save_state did: no history of the steps since
   b.state.x = Eigen::Map<const Eigen::VectorXd>(saved.positions.data(), b.state.x.size());
   b.state.v = Eigen::Map<const Eigen::VectorXd>(saved.velocities.data(), b.state.v.size());
   b.previous_v = b.state.v;

@@ -39,6 +39,9 @@ int measure_and_write(const ArgParser& args, const BenchOptions& options, bool r
   if (!options.json.empty()) check_writable(options.json);
   const SourceState source = source_state();
   print_setup(scene, options, source);
+  if (options.verbose)  // what each chapter's stepper builds, before the measured ones
+    for (const ChapterInfo* c : options.chapters)
+      std::cout << c->id << ": " << *c->make(scene, options.solver);
   LoadMonitor load;
   std::cout << "running " << options.chapters.size() << " chapters interleaved, " << Schedule::turn
             << " steps of each in turn" << std::endl;

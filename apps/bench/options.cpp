@@ -72,6 +72,8 @@ void add_bench_options(ArgParser& args) {
   args.flag("replace", "replace the run (bench.json and its plots) in --out DIR or at --json FILE");
   args.option("json", "FILE", "write the JSON here instead of DIR/bench.json", "");
   args.flag("no-json", "write no JSON (print the tables only)");
+  args.flag("verbose",
+            "print what each chapter's stepper builds: its recipe's parts and their data");
   args.flag("no-solvers", "skip the solve table (Eigen CG, with guess, ours, IC, LDLT, CHOLMOD)");
   args.option("threads", "LIST",
               "thread counts for the parallel chapters (09 on), comma-separated (default: 1 and "
@@ -93,6 +95,7 @@ BenchOptions bench_options(const ArgParser& args) {
   o.json = json_path(args);
   o.json_named = !args.get("json").empty();
   o.replace = args.has_flag("replace");
+  o.verbose = args.has_flag("verbose");
   if (!o.json.empty() && !o.json_named && args.get("out").empty())
     o.latest = std::filesystem::path(o.json).parent_path().filename().string();
   if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))

@@ -21,6 +21,7 @@ struct BenchOptions {
   bool replace = false;     // --replace: an earlier run at the same place may be replaced
   std::string latest;       // the run's folder is a new one under results/: point latest at it
   bool solve_tables = true;
+  bool verbose = false;  // --verbose: print what each chapter's stepper builds
 };
 
 // The scene's, the solver's and fem_bench's own options.

@@ -21,6 +21,9 @@ class MeshOrder {
 
   MeshOrder(const Scene& scene, const Params&) : scene_(scene) {}
   const Scene& scene() const { return scene_; }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) {
+    scene_.constraints = constraints;
+  }
   int element_group() const { return 0; }
   template <class Step>
   void step(State& state, Step&& inner) {
@@ -95,6 +98,8 @@ class SerialPcg {
     return ch07::pcg_solve(system.A, system.index.diagonal, system.filtered_b, constraints_,
                            settings, pcg_, system.y);
   }
+  // The constraints are read from the order's scene at every solve: nothing to keep.
+  void set_constraints(const std::vector<NodeConstraint>&) {}
   const ch07::PcgWorkspace& workspace() const { return pcg_; }
 
  private:

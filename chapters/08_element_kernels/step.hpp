@@ -27,6 +27,8 @@
 
 #include <Eigen/Core>
 #include <ostream>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
@@ -163,6 +165,20 @@ class StepOf final : public Stepper {
       out << "  " << part.role << ": " << part.name << " (" << part.chapter << ")\n";
     });
     describe_parts(out, order_, elements_, preconditioner_);
+  }
+
+  // Constraints change while the body runs (a grab, a release, a floor's contacts): the order
+  // renames them, the step's filter and the solver read them from the next step on. The
+  // preconditioner keeps what it was set up with (a multigrid's rigid-body modes): under the
+  // PCG's filter it stays a symmetric positive definite preconditioner, perhaps a weaker one.
+  // Throws std::invalid_argument for a node out of range, and changes nothing then.
+  bool can_change_constraints() const override { return true; }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    for (const NodeConstraint& c : constraints)
+      if (c.node < 0 || c.node >= model_.num_nodes)
+        throw std::invalid_argument("set_constraints: no node " + std::to_string(c.node));
+    order_.set_constraints(constraints);
+    solver_.set_constraints(order_.scene().constraints);
   }
 
   // The parts, for the tests, the lessons, the roofline and the summary.

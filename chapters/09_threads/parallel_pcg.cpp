@@ -51,19 +51,29 @@ void BlockJacobi::apply_rows(int first, int last, const Eigen::VectorXd& r,
 
 // ---- the solver ---------------------------------------------------------------------------
 
+void ParallelPcg::set_constraints(const std::vector<NodeConstraint>& constraints) {
+  constraints_by_part(constraints, chunks_.start, constraints_, constraint_start_);
+}
+
+void constraints_by_part(const std::vector<NodeConstraint>& constraints,
+                         const std::vector<int>& start, std::vector<NodeConstraint>& sorted,
+                         std::vector<int>& first) {
+  sorted = constraints;  // a copy: no reference into a scene
+  std::stable_sort(
+      sorted.begin(), sorted.end(),
+      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+  const int parts = static_cast<int>(start.size()) - 1;
+  first.assign(parts + 1, 0);
+  for (int p = 0, k = 0; p < parts; ++p) {
+    while (k < static_cast<int>(sorted.size()) && sorted[k].node < start[p + 1]) ++k;
+    first[p + 1] = k;
+  }
+}
+
 ParallelPcg::ParallelPcg(const BlockSparseMatrix& pattern,
                          const std::vector<NodeConstraint>& constraints)
-    : chunks_(pattern), constraints_(constraints) {  // a copy: no reference into a scene
-  // The constraints of each chunk, in node order.
-  std::stable_sort(
-      constraints_.begin(), constraints_.end(),
-      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
-  constraint_start_.assign(chunks_.count() + 1, 0);
-  for (int c = 0, k = 0; c < chunks_.count(); ++c) {
-    while (k < static_cast<int>(constraints_.size()) && constraints_[k].node < chunks_.start[c + 1])
-      ++k;
-    constraint_start_[c + 1] = k;
-  }
+    : chunks_(pattern) {
+  set_constraints(constraints);
   for (auto* partial : {&partial_bb_, &partial_pq_, &partial_rr_, &partial_rs_})
     partial->assign(chunks_.count(), 0.0);
 }

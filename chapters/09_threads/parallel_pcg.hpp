@@ -54,6 +54,12 @@ class Preconditioner {
   virtual void apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s);
 };
 
+// The constraints sorted by node into `sorted`, and where each part's begin there: part p (its
+// rows start[p] .. start[p + 1] - 1) holds sorted[first[p]] .. sorted[first[p + 1] - 1].
+void constraints_by_part(const std::vector<NodeConstraint>& constraints,
+                         const std::vector<int>& start, std::vector<NodeConstraint>& sorted,
+                         std::vector<int>& first);
+
 // Block Jacobi, s_i = D_i^-1 r_i with D_i the 3x3 diagonal block: chapter 07's, per chunk.
 class BlockJacobi final : public Preconditioner {
  public:
@@ -75,6 +81,8 @@ class ParallelPcg {
  public:
   ParallelPcg() = default;
   ParallelPcg(const BlockSparseMatrix& pattern, const std::vector<NodeConstraint>& constraints);
+  // The filter's constraints from the next solve on (a grab, a release, a floor's contacts).
+  void set_constraints(const std::vector<NodeConstraint>& constraints);
   // y holds the initial guess on entry and the solution on exit.
   SolveStats solve(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
                    const SolverSettings& settings, Eigen::VectorXd& y);

@@ -68,6 +68,9 @@ class ParallelPcgSolver {
     return pcg_.solve(system.A, preconditioner.pcg_preconditioner(), system.filtered_b, settings,
                       system.y);
   }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) {
+    pcg_.set_constraints(constraints);
+  }
   ParallelPcg& pcg() { return pcg_; }
 
  private:

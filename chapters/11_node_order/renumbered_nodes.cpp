@@ -20,6 +20,11 @@ int RenumberedNodes::element_group() const {
   return std::max(16, scene_.mesh.num_tets() / kSlabs);
 }
 
+void RenumberedNodes::set_constraints(const std::vector<NodeConstraint>& constraints) {
+  scene_.constraints = constraints;
+  for (NodeConstraint& c : scene_.constraints) c.node = order_.new_of_old[c.node];
+}
+
 void RenumberedNodes::map_in(const State& caller) {
   // Node k of the new numbering is node old_of_new[k] of the caller's: two gathers in, two
   // scatters out, 12 doubles per node, against the thousands of bytes a node costs the step.

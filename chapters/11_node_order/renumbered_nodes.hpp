@@ -24,6 +24,8 @@ class RenumberedNodes {
 
   RenumberedNodes(const Scene& scene, const Params& params);
   const Scene& scene() const { return scene_; }  // in the new numbering
+  // The caller's constraints, renamed into the new numbering.
+  void set_constraints(const std::vector<NodeConstraint>& constraints);
   // Chapter 09 colours groups of 16 consecutive elements, and its pass goes colour by colour:
   // every colour visits the whole mesh, so a node's blocks of A are fetched again for every
   // colour among its elements' groups (the plate: 62 colours). Sorted along the mesh,

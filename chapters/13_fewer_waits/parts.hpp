@@ -51,6 +51,10 @@ class SingleReductionSolver {
     if (!M.fused()) return parallel_.solve(system.A, M, system.filtered_b, settings, system.y);
     return single_reduction_.solve(system.A, M, system.filtered_b, settings, system.y);
   }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) {
+    single_reduction_.set_constraints(constraints);
+    parallel_.set_constraints(constraints);
+  }
   SingleReductionPcg& single_reduction() { return single_reduction_; }
 
  private:

@@ -14,18 +14,15 @@
 
 namespace fem::ch13 {
 
+void SingleReductionPcg::set_constraints(const std::vector<NodeConstraint>& constraints) {
+  ch09::constraints_by_part(constraints, part_, constraints_, constraint_start_);
+}
+
 SingleReductionPcg::SingleReductionPcg(const std::vector<int>& part,
                                        const std::vector<NodeConstraint>& constraints)
-    : part_(part), constraints_(constraints) {  // copies: no reference into a scene
-  std::stable_sort(
-      constraints_.begin(), constraints_.end(),
-      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+    : part_(part) {
+  set_constraints(constraints);
   const int parts = static_cast<int>(part_.size()) - 1;
-  constraint_start_.assign(parts + 1, 0);
-  for (int p = 0, k = 0; p < parts; ++p) {
-    while (k < static_cast<int>(constraints_.size()) && constraints_[k].node < part_[p + 1]) ++k;
-    constraint_start_[p + 1] = k;
-  }
   for (auto* partial : {&partial_bb_, &partial_rr_, &partial_gamma_, &partial_delta_})
     partial->assign(parts, 0.0);
 }

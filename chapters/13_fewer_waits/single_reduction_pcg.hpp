@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/13_fewer_waits/fused_v_cycle.hpp"
 #include "common/stepper.hpp"
 
@@ -22,6 +23,8 @@ class SingleReductionPcg {
  public:
   // The rows of `part` are the fused cycle's finest row blocks (FusedVCycle::fine_part).
   SingleReductionPcg(const std::vector<int>& part, const std::vector<NodeConstraint>& constraints);
+  // The filter's constraints from the next solve on (a grab, a release, a floor's contacts).
+  void set_constraints(const std::vector<NodeConstraint>& constraints);
   // y holds the initial guess on entry and the solution on exit; the same stopping rule and
   // PPCG filter as chapter 09's PCG. M must be fused() (FusedVCycle).
   SolveStats solve(const ch07::BlockSparseMatrix& A, FusedVCycle& M, const Eigen::VectorXd& b,

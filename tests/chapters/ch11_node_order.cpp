@@ -163,3 +163,33 @@ TEST_CASE("ch11: zero heap allocations per step after the first, with 2 threads"
   const ThreadCountScope two(2);
   CHECK(test::allocations_per_step("11", test::driven_scene()) == 0);
 }
+
+TEST_CASE("ch11: constraints set while the body runs name the caller's nodes", "[ch11]") {
+  // A node fixed at rest velocity stops where it is, to the bit (S_i = 0 and z_i = -v_i): in
+  // the caller's numbering, although the step runs in the renumbered one.
+  const Scene scene = test::test_scene("cantilever");
+  ch11::NodeOrderStepper stepper(scene, {});
+  REQUIRE(stepper.can_change_constraints());
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  int node = scene.mesh.num_nodes() - 1;
+  const auto constrained = [&](int n) {
+    return std::any_of(scene.constraints.begin(), scene.constraints.end(),
+                       [n](const NodeConstraint& c) { return c.node == n; });
+  };
+  while (constrained(node)) --node;
+  REQUIRE(state.v.segment<3>(3 * node).norm() > 0.0);  // it was moving
+  std::vector<NodeConstraint> held = scene.constraints;
+  held.push_back(NodeConstraint::fixed(node));
+  CHECK_THROWS_AS(stepper.set_constraints({NodeConstraint::fixed(scene.mesh.num_nodes())}),
+                  std::invalid_argument);
+  stepper.set_constraints(held);
+  const Eigen::Vector3d at = state.x.segment<3>(3 * node);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  CHECK(state.x.segment<3>(3 * node) == at);
+  CHECK(state.v.segment<3>(3 * node).isZero(0.0));
+  // Released, it moves again.
+  stepper.set_constraints(scene.constraints);
+  stepper.step(state);
+  CHECK(state.x.segment<3>(3 * node) != at);
+}

@@ -6,6 +6,7 @@
 // mouse spring; the stepper matches chapter 01 and allocates nothing per step (generic tests).
 #include <memory>
 #include <random>
+#include <sstream>
 
 #include "catch2_compat.hpp"
 #include "chapters/09_threads/parallel.hpp"
@@ -341,4 +342,23 @@ TEST_CASE("ch13: the iterations lesson's counts, per setting, the same on 1 and 
   CHECK(plain.bytes_per_iteration < base.bytes_per_iteration);
   // Per step: the iterations' bytes and, once, the finest level's conversion to float.
   CHECK(base.bytes_per_step > base.mean_iterations * base.bytes_per_iteration);
+}
+
+TEST_CASE("ch13: the printed summary names every part of the recipe and the hierarchy's levels",
+          "[ch13]") {
+  const Scene scene = test::test_scene("cantilever");
+  const ch13::FewerWaitsStepper stepper(scene, {});
+  std::ostringstream out;
+  out << static_cast<const Stepper&>(stepper);
+  const std::string text = out.str();
+  ch13::FewerWaitsStepper::for_each_part([&](const ch08::PartName& part) {
+    INFO(part.role);
+    CHECK(text.find(std::string(part.role) + ": " + part.name + " (" + std::string(part.chapter) +
+                    ")") != std::string::npos);
+  });
+  const int levels = stepper.preconditioner().multigrid().levels();
+  for (int l = 0; l < levels; ++l)
+    CHECK(text.find("level " + std::to_string(l) + ":") != std::string::npos);
+  CHECK(text.find("(13_fewer_waits)") != std::string::npos);
+  CHECK(text.find("(11_node_order)") != std::string::npos);
 }

@@ -222,6 +222,9 @@ TEST_CASE("the supports' reactions carry the body's weight at rest", "[library]"
 }
 
 TEST_CASE("grab, drag and release equal rebuilding the body with those constraints", "[library]") {
+  // The body changes its stepper's constraints in place (the last chapter can): the solver's
+  // warm start and the hierarchy carry over, so the motion equals the rebuilt bodies' to the
+  // solver's tolerance, not to the bit; the grabbed nodes follow their velocity exactly.
   const BodyDescription d = beam();
   Body body(d);
   const std::vector<int> tip = tip_nodes(body);
@@ -244,7 +247,14 @@ TEST_CASE("grab, drag and release equal rebuilding the body with those constrain
   Body third(d);
   third.set_state(second.state());
   steps(third, 5);
-  CHECK(positions_of(body) == positions_of(third));
+  CHECK(body.changes_constraints_in_place());
+  const std::vector<double> ours = positions_of(body), rebuilt = positions_of(third);
+  REQUIRE(ours.size() == rebuilt.size());
+  double worst = 0.0;
+  for (std::size_t k = 0; k < ours.size(); ++k)
+    worst = std::max(worst, std::abs(ours[k] - rebuilt[k]));
+  INFO("largest difference " << worst << " m");
+  CHECK(worst < 1e-5);  // the beam is 1 m long: 10 um, the CG tolerance's order
   CHECK(body.grabbed().empty());
 }
 
