@@ -85,27 +85,22 @@ EXERCISES = [
      "lesson": "build/release/fem_lessons multigrid --chapter 10_NAME"},
     # Written in chapter 10's README, done in a variant of chapter 09 and measured beside both.
     {"id": "10/5", "chapter": "09", "readme": "10", "name": "ex_guess",
-     "change": [("stepper.hpp", "  long long steps_taken_ = 0;\n",
-                 "  long long steps_taken_ = 0;\n"
-                 "  Eigen::VectorXd previous_, before_previous_;  // y_(n-1), y_(n-2)\n"),
-                ("  // Warm start: y_ still holds the previous step's answer; the solver filters it.\n",
-                 "  if (previous_.size() != y_.size()) previous_ = before_previous_ = y_;\n"
-                 "  for (Eigen::Index k = 0; k < y_.size(); ++k) {\n"
-                 "    const double last = y_[k];\n"
-                 "    y_[k] = 3.0 * last - 3.0 * previous_[k] + before_previous_[k];\n"
-                 "    before_previous_[k] = previous_[k];\n"
-                 "    previous_[k] = last;\n"
-                 "  }\n")],
+     "change": [("stepper.hpp", "  using Guess = ch08::WarmStart;          // chapter 08's\n",
+                 "  using Guess = ch10::Extrapolation;      // chapter 10's\n"),
+                ("stepper.hpp", "#include \"chapters/08_element_kernels/step.hpp\"\n",
+                 "#include \"chapters/08_element_kernels/step.hpp\"\n"
+                 "#include \"chapters/10_multigrid/parts.hpp\"\n")],
      "bench": "build/release/fem_bench --chapters 09,09_NAME,10 --steps 30 --no-solvers --no-json",
      "expect": "measured", "also": ["10_multigrid"]},
     {"id": "11/2", "chapter": "11", "name": "ex_slabs",
-     "change": [("stepper.hpp", "static constexpr int kSlabs = 64;", "static constexpr int kSlabs = 8;")],
+     "change": [("renumbered_nodes.hpp", "static constexpr int kSlabs = 64;",
+                 "static constexpr int kSlabs = 8;")],
      "bench": "build/release/fem_bench --chapters 11,11_NAME --threads 1,2 --steps 30 --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons node-order --chapter 11_NAME"},
     {"id": "12/1", "chapter": "12", "name": "ex_widened",
-     "change": [("stepper.hpp", "Arithmetic arithmetic = Arithmetic::single,",
-                 "Arithmetic arithmetic = Arithmetic::double_on_float,")],
+     "change": [("stepper.hpp", "using Preconditioner = ReducedMultigrid<float>;",
+                 "using Preconditioner = ReducedMultigrid<double>;")],
      "bench": "build/release/fem_bench --chapters 12,12_NAME --threads 1,2 --steps 30 --no-solvers --no-json",
      "expect": "measured"},
     {"id": "12/2", "chapter": "12", "name": "ex_unpadded",
