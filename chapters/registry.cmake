@@ -2,8 +2,9 @@
 # a chapter, found by the build, so adding a chapter (or a variant, ./tutorial.sh variant)
 # edits no list. The convention it reads (chapters/README.md):
 #   stepper.hpp  declares the stepper inside `namespace fem::<ns> {` as
-#                `class <Name> [final] : public Stepper` (or `public chNN::<Name>Stepper`, a chapter's
-#                stepper it extends), constructible from (Scene, SolverSettings);
+#                `class <Name> [final] : public Stepper` (chapters 01-07) or as a recipe's step,
+#                `using <Name> = ch08::StepOf<Recipe>;` (chapter 08 on), constructible from
+#                (Scene, SolverSettings);
 #   README.md    starts with `# Chapter NN: <title>`, the title the apps and the results show;
 #   variant_of   (variants only) one line, the id of the chapter it was copied from;
 #   work.hpp     (optional) count_work for its stepper: the registry's `work` hook (chapters/work.hpp).

@@ -34,8 +34,9 @@ struct ChapterInfo {
   // says how): a run's JSON records it, so a hand-in's run is tied to the code handed in.
   std::string source_hash;
   // How the chapter counts its own work per phase (chapters/work.hpp), from the data of the
-  // stepper its `make` returns: its work.hpp's count_work, or that of the chapter it extends
-  // (found by argument-dependent lookup on its stepper's class); empty if none counts.
+  // stepper its `make` returns: count_work found by argument-dependent lookup (a chapter
+  // 01-07 stepper's own; from chapter 08 on the sum of its recipe's parts' counts, chapter 08's
+  // work.hpp), and the kernels of its parts that the roofline times alone; empty if none counts.
   ChapterWork work;
   // Which parts run each phase, from the stepper's recipe; empty for a stepper that is one
   // class (chapters 01-07: its step() runs every phase).
