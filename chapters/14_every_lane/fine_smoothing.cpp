@@ -8,9 +8,26 @@ namespace fem::ch14 {
 // float hierarchy's).
 static_assert(ch10::check_level_kernels<LaneFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
 
+// The V-cycle's polynomial step (d = alpha d + beta D^-1 (b - A in), out = in + d) with the
+// new d kept in registers: written as `d = ...; out = in + d`, the compiler must read d back
+// from memory (out might be d), a store and a load on every row's chain.
 void smooth_rows(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out) {
-  ch10::smooth(level, k, first, last, b, in, out, true);
+  const float alpha = level.smoother.weights[2 * k], beta = level.smoother.weights[2 * k + 1];
+  const bool restart = k == 0 || !in;
+  for (int i = first; i < last; ++i) {
+    Eigen::Vector3f r = b.segment<3>(3 * i);
+    if (in) r -= level.blocks.row_product(i, in->data());
+    auto d = level.vectors.direction.segment<3>(3 * i);
+    const Eigen::Vector3f t = times_inverse_diagonal(level, i, r);
+    const Eigen::Vector3f next =
+        restart ? Eigen::Vector3f(beta * t) : Eigen::Vector3f(alpha * d + beta * t);
+    d = next;
+    if (in)
+      out.segment<3>(3 * i) = in->segment<3>(3 * i) + next;
+    else
+      out.segment<3>(3 * i) = next;
+  }
 }
 
 void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,

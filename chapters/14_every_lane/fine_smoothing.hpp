@@ -55,6 +55,13 @@ void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::Vecto
 
 // ---- the level's kernels for the V-cycle (argument-dependent lookup) ---------------------
 
+// The V-cycle's smooth on this level: the polynomial step above (a better match than the
+// V-cycle's generic one for every polynomial level).
+inline void smooth(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
+                   const Eigen::VectorXf* in, Eigen::VectorXf& out, bool /*forward*/) {
+  smooth_rows(level, k, first, last, b, in, out);
+}
+
 inline const ch10::Level<3>& source_level(const LaneFineLevel& level) {
   return *level.level.source;
 }
