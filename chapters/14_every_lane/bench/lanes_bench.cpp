@@ -5,7 +5,7 @@
 // in one run, and set beside the bound of each one's own bytes and flops under the machine's
 // roofs measured in the same run.
 //
-//   lanes_bench [--mesh meshes/plate_poster.msh] [--rounds 5] [--roof-seconds 0.3]
+//   lanes_bench [--mesh meshes/plate_poster.msh] [--rounds 5] [--roof-seconds 0.3] [--threads N]
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdio>
@@ -37,6 +37,7 @@ struct Options {
   std::string mesh = "meshes/plate_poster.msh";
   int rounds = 5;
   double roof_seconds = 0.3;
+  int threads = 0;  // 0: 1 and 2 threads
 };
 
 Options parse(int argc, char** argv) {
@@ -46,6 +47,7 @@ Options parse(int argc, char** argv) {
     if (key == "--mesh") o.mesh = value;
     if (key == "--rounds") o.rounds = std::stoi(value);
     if (key == "--roof-seconds") o.roof_seconds = std::stod(value);
+    if (key == "--threads") o.threads = std::stoi(value);
   }
   return o;
 }
@@ -169,6 +171,7 @@ int main(int argc, char** argv) {
       "| kernel | threads | old us | new us | new/old | bound old / new us | old of its bound | "
       "new of its bound | new of old's bound |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (int threads = 1; threads <= max_threads; ++threads) {
+    if (o.threads > 0 && threads != o.threads) continue;
     // --roof-seconds 0: no roofs (the kernels' times and ratios only, quickly).
     const roofline::Roofs roofs =
         o.roof_seconds > 0
