@@ -8,38 +8,72 @@ namespace fem::ch14 {
 // float hierarchy's).
 static_assert(ch10::check_level_kernels<LaneFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
 
-// The V-cycle's polynomial step (d = alpha d + beta D^-1 (b - A in), out = in + d) with the
-// new d kept in registers: written as `d = ...; out = in + d`, the compiler must read d back
-// from memory (out might be d), a store and a load on every row's chain.
+namespace {
+
+struct Weights {
+  float alpha, beta;
+  bool restart;  // d = beta D^-1 r (the first step, or from zero)
+};
+
+// Row i of the polynomial step from its product `sum` (unused from zero): d = alpha d + beta
+// D^-1 (b - sum), out = in + d, with the new d kept in registers (written as `d = ...;
+// out = in + d` the compiler must read d back, out might be d: a store and a load on the
+// row's chain). The update is one multiply-add and a multiply: which multiply the compiler
+// fuses depends on the code around it, so it may round differently from the V-cycle's own.
+EIGEN_ALWAYS_INLINE void update_row(LaneFineLevel& level, int i, const Eigen::Vector3f& sum,
+                                    const Weights& w, const Eigen::VectorXf& b,
+                                    const Eigen::VectorXf* in, Eigen::VectorXf& out) {
+  Eigen::Vector3f r = b.segment<3>(3 * i);
+  if (in) r -= sum;
+  auto d = level.vectors.direction.segment<3>(3 * i);
+  const Eigen::Vector3f t = times_inverse_diagonal(level, i, r);
+  const Eigen::Vector3f next =
+      w.restart ? Eigen::Vector3f(w.beta * t) : Eigen::Vector3f(w.alpha * d + w.beta * t);
+  d = next;
+  if (in)
+    out.segment<3>(3 * i) = in->segment<3>(3 * i) + next;
+  else
+    out.segment<3>(3 * i) = next;
+}
+
+}  // namespace
+
 void smooth_rows(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out) {
-  const float alpha = level.smoother.weights[2 * k], beta = level.smoother.weights[2 * k + 1];
-  const bool restart = k == 0 || !in;
-  for (int i = first; i < last; ++i) {
-    Eigen::Vector3f r = b.segment<3>(3 * i);
-    if (in) r -= level.blocks.row_product(i, in->data());
-    auto d = level.vectors.direction.segment<3>(3 * i);
-    const Eigen::Vector3f t = times_inverse_diagonal(level, i, r);
-    const Eigen::Vector3f next =
-        restart ? Eigen::Vector3f(beta * t) : Eigen::Vector3f(alpha * d + beta * t);
-    d = next;
-    if (in)
-      out.segment<3>(3 * i) = in->segment<3>(3 * i) + next;
-    else
-      out.segment<3>(3 * i) = next;
+  const Weights w{level.smoother.weights[2 * k], level.smoother.weights[2 * k + 1],
+                  k == 0 || !in};
+  Eigen::Vector3f sums[2] = {Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
+  for (int i = first; i < last; i += 2) {
+    if (in) level.blocks.row_products(i, in->data(), sums[0], sums[1]);
+    update_row(level, i, sums[0], w, b, in, out);
+    if (!level.blocks.has_partner(i)) {
+      --i;  // alone: the next pair starts at i + 1
+      continue;
+    }
+    update_row(level, i + 1, sums[1], w, b, in, out);
   }
 }
 
 void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf& x) {
-  ch10::residual(level, first, last, b, x);
+  Eigen::Vector3f sums[2];
+  auto& residual = level.vectors.residual;
+  for (int i = first; i < last; i += 2) {
+    level.blocks.row_products(i, x.data(), sums[0], sums[1]);
+    residual.segment<3>(3 * i) = b.segment<3>(3 * i) - sums[0];
+    if (!level.blocks.has_partner(i)) {
+      --i;
+      continue;
+    }
+    residual.segment<3>(3 * i + 3) = b.segment<3>(3 * i + 3) - sums[1];
+  }
 }
 
 namespace {
 
 // A float vector of the level, and its inverse diagonal (3x3 float blocks).
-double vector_bytes(const PairedBlocks<float>& A) { return 3.0 * sizeof(float) * A.rows(); }
-double inverse_bytes(const PairedBlocks<float>& A) { return 9.0 * sizeof(float) * A.rows(); }
+double vector_bytes(const RowPairBlocks& A) { return 3.0 * sizeof(float) * A.rows(); }
+double inverse_bytes(const RowPairBlocks& A) { return 9.0 * sizeof(float) * A.rows(); }
 
 }  // namespace
 

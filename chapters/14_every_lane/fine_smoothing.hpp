@@ -1,14 +1,14 @@
-// The V-cycle's finest level in float with its products in pair lanes (paired_blocks.hpp): the
-// polynomial smoothing step and the residual, which the V-cycle runs on it some twelve times
-// per cycle, and which alone took two thirds of a step with a quarter of the lanes busy.
+// The V-cycle's finest level in float with its products in the lanes of row pairs
+// (row_pairs.hpp): the polynomial smoothing step and the residual, which the V-cycle runs on
+// it some twelve times per cycle, and which alone took two thirds of a step with a quarter of
+// the lanes busy.
 //
 // A part for a stepper: a level type of the V-cycle (v_cycle.hpp's interface, found by
 // argument-dependent lookup) that views a float level (its inverse diagonal, weights and
-// vectors stay that level's) and holds the level's matrix in its own layout. The V-cycle's
-// own smoothing step and residual (chapter 10's polynomial_step, written once for every level)
-// run on it with the lanes' row_product: the same expressions around the product, and in the
-// product the same multiply-adds per lane in the same order, so every result is the padded
-// columns' to the bit and the solve stays what it was.
+// vectors stay that level's) and holds the level's matrix in its own layout. In the product
+// the same multiply-adds per lane in the same order as the padded columns: the residual is
+// theirs to the bit; the smoothing step's update rounds once where the compiler chooses (see
+// smooth_rows), within a float epsilon of its terms.
 #pragma once
 
 #include <Eigen/Core>
@@ -16,7 +16,7 @@
 #include "chapters/10_multigrid/smoothers.hpp"
 #include "chapters/12_half_the_bytes/reduced_kernels.hpp"
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
-#include "chapters/14_every_lane/paired_blocks.hpp"
+#include "chapters/14_every_lane/row_pairs.hpp"
 #include "chapters/work.hpp"
 
 namespace fem::ch14 {
@@ -27,12 +27,17 @@ using CoarseFloatLevel = ch12::ReducedLevel<float, ch10::kModes>;
 struct LaneFineLevel : ch10::PolynomialLevel {
   static constexpr int block_size = 3;
 
-  // The layout of the level's pattern (set-up); the level must outlive this object.
+  // The layout of the level's pattern in its row blocks (set-up); the level must outlive
+  // this object.
   explicit LaneFineLevel(FloatLevel& level)
-      : level(level), smoother(level.smoother), vectors(level.vectors), blocks(level.source->A) {}
+      : level(level),
+        smoother(level.smoother),
+        vectors(level.vectors),
+        blocks(level.source->A, level.source->rows.part) {}
 
-  // The level's double values (its source's) into the lanes, rows [first, last): after each
-  // factorization, by every thread on its rows. Rounded to float as the float level's are.
+  // The level's double values (its source's) into the lanes, rows [first, last) of whole
+  // row blocks: after each factorization, by every thread on its row blocks. Rounded to
+  // float as the float level's are.
   void fill(int first, int last) { blocks.fill(level.source->values, first, last); }
 
   // One call over every row: bytes and flops (float) as chapters/work.hpp counts them.
@@ -42,33 +47,33 @@ struct LaneFineLevel : ch10::PolynomialLevel {
   FloatLevel& level;
   decltype(FloatLevel::smoother)& smoother;  // the V-cycle reads the weights here
   ch10::WorkVectors<float>& vectors;
-  PairedBlocks<float> blocks;
+  RowPairBlocks blocks;
 };
 
-// Step k of the polynomial smoother on rows [first, last) (from zero when in is null): out
-// and the level's direction written on those rows; every row of in must be written before.
+// Step k of the polynomial smoother on rows [first, last) of whole row blocks (from zero when
+// in is null): out and the level's direction written on those rows; every row of in must be
+// written before.
 void smooth_rows(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out);
-// b - A x on rows [first, last), into the level's residual vector.
+// b - A x on rows [first, last) of whole row blocks, into the level's residual vector.
 void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf& x);
 
 // ---- the level's kernels for the V-cycle (argument-dependent lookup) ---------------------
 
-// The V-cycle's smooth on this level: the polynomial step above (a better match than the
-// V-cycle's generic one for every polynomial level).
+// The V-cycle's smooth and residual on this level: the functions above (better matches than
+// the V-cycle's generic ones for every polynomial level).
 inline void smooth(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf* in, Eigen::VectorXf& out, bool /*forward*/) {
   smooth_rows(level, k, first, last, b, in, out);
 }
+inline void residual(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
+                     const Eigen::VectorXf& x) {
+  residual_rows(level, first, last, b, x);
+}
 
 inline const ch10::Level<3>& source_level(const LaneFineLevel& level) {
   return *level.level.source;
-}
-
-EIGEN_ALWAYS_INLINE Eigen::Vector3f row_product(const LaneFineLevel& level,
-                                                const Eigen::VectorXf& x, int begin, int end) {
-  return level.blocks.row_product(begin, end, x.data());
 }
 
 template <class Rhs>
