@@ -7,6 +7,7 @@ namespace fem::ch14 {
 // The lanes' level brings every kernel the V-cycle calls (a coarse level below it is the
 // float hierarchy's).
 static_assert(ch10::check_level_kernels<LaneFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
+static_assert(ch10::check_level_kernels<RowPairFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
 
 namespace {
 
@@ -20,12 +21,13 @@ struct Weights {
 // out = in + d` the compiler must read d back, out might be d: a store and a load on the
 // row's chain). The update is one multiply-add and a multiply: which multiply the compiler
 // fuses depends on the code around it, so it may round differently from the V-cycle's own.
-EIGEN_ALWAYS_INLINE void update_row(LaneFineLevel& level, int i, const Eigen::Vector3f& sum,
+template <class Blocks>
+EIGEN_ALWAYS_INLINE void update_row(LaneLevel<Blocks>& level, int i, const Eigen::Vector3f& sum,
                                     const Weights& w, const Eigen::VectorXf& b,
                                     const Eigen::VectorXf* in, Eigen::VectorXf& out) {
   Eigen::Vector3f r = b.segment<3>(3 * i);
   if (in) r -= sum;
-  auto d = level.vectors.direction.segment<3>(3 * i);
+  auto d = level.vectors.direction.template segment<3>(3 * i);
   const Eigen::Vector3f t = times_inverse_diagonal(level, i, r);
   const Eigen::Vector3f next =
       w.restart ? Eigen::Vector3f(w.beta * t) : Eigen::Vector3f(w.alpha * d + w.beta * t);
@@ -38,42 +40,49 @@ EIGEN_ALWAYS_INLINE void update_row(LaneFineLevel& level, int i, const Eigen::Ve
 
 }  // namespace
 
-void smooth_rows(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+void smooth_rows(LaneLevel<Blocks>& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out) {
-  const Weights w{level.smoother.weights[2 * k], level.smoother.weights[2 * k + 1],
-                  k == 0 || !in};
-  Eigen::Vector3f sums[2] = {Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero()};
-  for (int i = first; i < last; i += 2) {
-    if (in) level.blocks.row_products(i, in->data(), sums[0], sums[1]);
-    update_row(level, i, sums[0], w, b, in, out);
-    if (!level.blocks.has_partner(i)) {
-      --i;  // alone: the next pair starts at i + 1
-      continue;
-    }
-    update_row(level, i + 1, sums[1], w, b, in, out);
+  const Weights w{level.smoother.weights[2 * k], level.smoother.weights[2 * k + 1], k == 0 || !in};
+  const auto update = [&](int i, const Eigen::Vector3f& sum) {
+    update_row(level, i, sum, w, b, in, out);
+  };
+  if (in) {
+    level.blocks.for_rows(first, last, in->data(), update);
+    return;
   }
+  for (int i = first; i < last; ++i) update(i, Eigen::Vector3f::Zero());
 }
 
-void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+void residual_rows(LaneLevel<Blocks>& level, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf& x) {
-  Eigen::Vector3f sums[2];
   auto& residual = level.vectors.residual;
-  for (int i = first; i < last; i += 2) {
-    level.blocks.row_products(i, x.data(), sums[0], sums[1]);
-    residual.segment<3>(3 * i) = b.segment<3>(3 * i) - sums[0];
-    if (!level.blocks.has_partner(i)) {
-      --i;
-      continue;
-    }
-    residual.segment<3>(3 * i + 3) = b.segment<3>(3 * i + 3) - sums[1];
-  }
+  level.blocks.for_rows(first, last, x.data(), [&](int i, const Eigen::Vector3f& sum) {
+    residual.template segment<3>(3 * i) = b.segment<3>(3 * i) - sum;
+  });
 }
+
+template void smooth_rows(LaneFineLevel&, int, int, int, const Eigen::VectorXf&,
+                          const Eigen::VectorXf*, Eigen::VectorXf&);
+template void smooth_rows(RowPairFineLevel&, int, int, int, const Eigen::VectorXf&,
+                          const Eigen::VectorXf*, Eigen::VectorXf&);
+template void residual_rows(LaneFineLevel&, int, int, const Eigen::VectorXf&,
+                            const Eigen::VectorXf&);
+template void residual_rows(RowPairFineLevel&, int, int, const Eigen::VectorXf&,
+                            const Eigen::VectorXf&);
 
 namespace {
 
 // A float vector of the level, and its inverse diagonal (3x3 float blocks).
-double vector_bytes(const RowPairBlocks& A) { return 3.0 * sizeof(float) * A.rows(); }
-double inverse_bytes(const RowPairBlocks& A) { return 9.0 * sizeof(float) * A.rows(); }
+template <class Blocks>
+double vector_bytes(const Blocks& A) {
+  return 3.0 * sizeof(float) * A.rows();
+}
+template <class Blocks>
+double inverse_bytes(const Blocks& A) {
+  return 9.0 * sizeof(float) * A.rows();
+}
 
 }  // namespace
 
@@ -81,7 +90,8 @@ double inverse_bytes(const RowPairBlocks& A) { return 9.0 * sizeof(float) * A.ro
 // direction read, the direction written back and the output written fresh (allocating its
 // lines). Per block 18 flops, per row the inverse diagonal's 18 and the update's 18: the
 // useful ones, not the padding lanes'.
-PhaseWork LaneFineLevel::smoothing_work() const {
+template <class Blocks>
+PhaseWork LaneLevel<Blocks>::smoothing_work() const {
   const double v = vector_bytes(blocks), rows = blocks.rows();
   PhaseWork w;
   w.phase = "smoothing step";
@@ -94,7 +104,8 @@ PhaseWork LaneFineLevel::smoothing_work() const {
 }
 
 // The residual: the lanes, x and b read, the residual written fresh; 18 flops a block, 3 a row.
-PhaseWork LaneFineLevel::residual_work() const {
+template <class Blocks>
+PhaseWork LaneLevel<Blocks>::residual_work() const {
   const double v = vector_bytes(blocks);
   PhaseWork w;
   w.phase = "residual";
@@ -105,5 +116,8 @@ PhaseWork LaneFineLevel::residual_work() const {
   w.working_set = blocks.bytes() + 3 * v;
   return w;
 }
+
+template struct LaneLevel<PairedBlocks<float>>;
+template struct LaneLevel<RowPairBlocks>;
 
 }  // namespace fem::ch14

@@ -1,7 +1,9 @@
-// The V-cycle's finest level in float with its products in the lanes of row pairs
-// (row_pairs.hpp): the polynomial smoothing step and the residual, which the V-cycle runs on
-// it some twelve times per cycle, and which alone took two thirds of a step with a quarter of
-// the lanes busy.
+// The V-cycle's finest level in float with its products in vector lanes filled across blocks:
+// the polynomial smoothing step and the residual, which the V-cycle runs on it some twelve
+// times per cycle, and which alone took two thirds of a step with a quarter of the lanes busy.
+// Two layouts: a row's blocks in pairs (paired_blocks.hpp, 256-bit registers: the faster on
+// AMD's Zen 4, whose 512-bit shuffles take two passes) and two rows' pairs side by side
+// (row_pairs.hpp, 512-bit registers, for cores with full-width shuffles: measure).
 //
 // A part for a stepper: a level type of the V-cycle (v_cycle.hpp's interface, found by
 // argument-dependent lookup) that views a float level (its inverse diagonal, weights and
@@ -16,6 +18,7 @@
 #include "chapters/10_multigrid/smoothers.hpp"
 #include "chapters/12_half_the_bytes/reduced_kernels.hpp"
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
+#include "chapters/14_every_lane/paired_blocks.hpp"
 #include "chapters/14_every_lane/row_pairs.hpp"
 #include "chapters/work.hpp"
 
@@ -24,16 +27,24 @@ namespace fem::ch14 {
 using FloatLevel = ch12::ReducedLevel<float, 3>;
 using CoarseFloatLevel = ch12::ReducedLevel<float, ch10::kModes>;
 
-struct LaneFineLevel : ch10::PolynomialLevel {
+// The layout of a level's pattern (and its row blocks, for the row pairs).
+inline PairedBlocks<float> lanes_of(const ch10::Level<3>& level, const PairedBlocks<float>*) {
+  return PairedBlocks<float>(level.A);
+}
+inline RowPairBlocks lanes_of(const ch10::Level<3>& level, const RowPairBlocks*) {
+  return RowPairBlocks(level.A, level.rows.part);
+}
+
+template <class Blocks>
+struct LaneLevel : ch10::PolynomialLevel {
   static constexpr int block_size = 3;
 
-  // The layout of the level's pattern in its row blocks (set-up); the level must outlive
-  // this object.
-  explicit LaneFineLevel(FloatLevel& level)
+  // The layout of the level's pattern (set-up); the level must outlive this object.
+  explicit LaneLevel(FloatLevel& level)
       : level(level),
         smoother(level.smoother),
         vectors(level.vectors),
-        blocks(level.source->A, level.source->rows.part) {}
+        blocks(lanes_of(*level.source, static_cast<const Blocks*>(nullptr))) {}
 
   // The level's double values (its source's) into the lanes, rows [first, last) of whole
   // row blocks: after each factorization, by every thread on its row blocks. Rounded to
@@ -47,51 +58,62 @@ struct LaneFineLevel : ch10::PolynomialLevel {
   FloatLevel& level;
   decltype(FloatLevel::smoother)& smoother;  // the V-cycle reads the weights here
   ch10::WorkVectors<float>& vectors;
-  RowPairBlocks blocks;
+  Blocks blocks;
 };
+using LaneFineLevel = LaneLevel<PairedBlocks<float>>;  // the pair lanes
+using RowPairFineLevel = LaneLevel<RowPairBlocks>;     // the row pairs
 
 // Step k of the polynomial smoother on rows [first, last) of whole row blocks (from zero when
 // in is null): out and the level's direction written on those rows; every row of in must be
 // written before.
-void smooth_rows(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+void smooth_rows(LaneLevel<Blocks>& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out);
 // b - A x on rows [first, last) of whole row blocks, into the level's residual vector.
-void residual_rows(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+void residual_rows(LaneLevel<Blocks>& level, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf& x);
 
 // ---- the level's kernels for the V-cycle (argument-dependent lookup) ---------------------
 
 // The V-cycle's smooth and residual on this level: the functions above (better matches than
 // the V-cycle's generic ones for every polynomial level).
-inline void smooth(LaneFineLevel& level, int k, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+inline void smooth(LaneLevel<Blocks>& level, int k, int first, int last, const Eigen::VectorXf& b,
                    const Eigen::VectorXf* in, Eigen::VectorXf& out, bool /*forward*/) {
   smooth_rows(level, k, first, last, b, in, out);
 }
-inline void residual(LaneFineLevel& level, int first, int last, const Eigen::VectorXf& b,
+template <class Blocks>
+inline void residual(LaneLevel<Blocks>& level, int first, int last, const Eigen::VectorXf& b,
                      const Eigen::VectorXf& x) {
   residual_rows(level, first, last, b, x);
 }
 
-inline const ch10::Level<3>& source_level(const LaneFineLevel& level) {
+template <class Blocks>
+inline const ch10::Level<3>& source_level(const LaneLevel<Blocks>& level) {
   return *level.level.source;
 }
 
-template <class Rhs>
-EIGEN_ALWAYS_INLINE Eigen::Vector3f times_inverse_diagonal(const LaneFineLevel& level, int i,
+template <class Blocks, class Rhs>
+EIGEN_ALWAYS_INLINE Eigen::Vector3f times_inverse_diagonal(const LaneLevel<Blocks>& level, int i,
                                                            const Rhs& r) {
   return ch12::times_inverse_diagonal(level.level, i, r);
 }
 
 // The transfers and the coarsest solve are the float level's.
-inline void restrict_rows(const LaneFineLevel& level, CoarseFloatLevel& coarse, int first,
+template <class Blocks>
+inline void restrict_rows(const LaneLevel<Blocks>& level, CoarseFloatLevel& coarse, int first,
                           int last) {
   ch12::restrict_rows(level.level, coarse, first, last);
 }
-inline void prolong_rows(LaneFineLevel& level, const CoarseFloatLevel& coarse, int first, int last,
-                         const Eigen::VectorXf& x) {
+template <class Blocks>
+inline void prolong_rows(LaneLevel<Blocks>& level, const CoarseFloatLevel& coarse, int first,
+                         int last, const Eigen::VectorXf& x) {
   ch12::prolong_rows(level.level, coarse, first, last, x);
 }
-inline void solve_coarsest(LaneFineLevel& level, const Eigen::VectorXf& b, Eigen::VectorXf& out) {
+template <class Blocks>
+inline void solve_coarsest(LaneLevel<Blocks>& level, const Eigen::VectorXf& b,
+                           Eigen::VectorXf& out) {
   ch12::solve_coarsest(level.level, b, out);
 }
 

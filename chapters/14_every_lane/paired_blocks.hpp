@@ -41,6 +41,12 @@ class PairedBlocks {
     return row_product(row_start_[i], row_start_[i + 1], x);
   }
 
+  // f(i, row i's sum) for every row i in [first, last).
+  template <class F>
+  void for_rows(int first, int last, const Scalar* x, F&& f) const {
+    for (int i = first; i < last; ++i) f(i, row_product(i, x));
+  }
+
   int rows() const { return static_cast<int>(row_start_.size()) - 1; }
   long long blocks() const { return row_start_.back(); }
   // The bytes one pass over every row reads of this object: values (padding included),

@@ -22,8 +22,7 @@ RowPairBlocks::RowPairBlocks(const ch07::BlockCsr<3, 3>& pattern, const std::vec
         bool end = false;
         for (int piece = 0; piece < 4; ++piece) {
           const int r = piece / 2, index = 2 * s + piece % 2;
-          const int offset =
-              index < counts[r] ? 3 * pattern.column[row_start_[i + r] + index] : 0;
+          const int offset = index < counts[r] ? 3 * pattern.column[row_start_[i + r] + index] : 0;
           x_offset_.push_back(offset);
           end = end || offset == last_x_offset_;
         }

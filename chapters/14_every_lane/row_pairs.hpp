@@ -96,6 +96,7 @@ class RowPairBlocks {
   static constexpr int kStep = 48;  // floats of one step: 3 columns of 2 rows x 8
 
   RowPairBlocks() = default;
+  // The layout of `pattern`'s rows paired within the row blocks `part` (values zero).
   RowPairBlocks(const ch07::BlockCsr<3, 3>& pattern, const std::vector<int>& part);
 
   // The values of row pairs that start in [first, last) (rows of one or more whole parts).
@@ -106,6 +107,17 @@ class RowPairBlocks {
   // i + 1, over their blocks; second is zero if i has no partner.
   void row_products(int i, const float* x, Eigen::Vector3f& first, Eigen::Vector3f& second) const;
 
+  // f(i, row i's sum) for every row i in [first, last) of whole row blocks, two at a time.
+  template <class F>
+  void for_rows(int first, int last, const float* x, F&& f) const {
+    Eigen::Vector3f sums[2];
+    for (int i = first; i < last; ++i) {
+      row_products(i, x, sums[0], sums[1]);
+      f(i, sums[0]);
+      if (has_partner(i)) f(++i, sums[1]);
+    }
+  }
+
   int rows() const { return static_cast<int>(row_start_.size()) - 1; }
   long long blocks() const { return row_start_.back(); }
   // Whether row i starts a pair with row i + 1 (else it is alone, or i + 1 starts the next).
@@ -115,11 +127,11 @@ class RowPairBlocks {
 
  private:
   std::vector<float, Eigen::aligned_allocator<float>> values_;
-  std::vector<int> row_start_{0};  // the pattern's
-  std::vector<int> group_;         // per row: its pair's index if it starts one, else -1
+  std::vector<int> row_start_{0};   // the pattern's
+  std::vector<int> group_;          // per row: its pair's index if it starts one, else -1
   std::vector<int> step_start_{0};  // per pair: its first step (kStep floats, 4 x offsets each)
-  std::vector<int> x_offset_;      // per step: the 4 pieces' 3 * column (padding: node 0's)
-  std::vector<char> at_end_;       // per step: whether its last piece is the last node's
+  std::vector<int> x_offset_;       // per step: the 4 pieces' 3 * column (padding: node 0's)
+  std::vector<char> at_end_;        // per step: whether its last piece is the last node's
   int last_x_offset_ = -1;
 };
 

@@ -68,8 +68,9 @@ struct Written {
 
 // Step k (from zero or from x) and the residual of x, by the padded columns (lanes null) or
 // by the lanes, on a team of `threads`: what they write.
-Written run_fine(ch12::ReducedLevel<float, 3>& level, ch14::LaneFineLevel* lanes, int k,
-                 bool from_zero, int threads) {
+template <class Lanes>
+Written run_fine(ch12::ReducedLevel<float, 3>& level, Lanes* lanes, int k, bool from_zero,
+                 int threads) {
   const Written start(level);
   const auto& part = source_level(level).rows.part;
   auto& v = level.vectors;
@@ -101,55 +102,69 @@ double worst(const Eigen::VectorXf& a, const Eigen::VectorXf& b, const Eigen::Ve
 }
 
 // The residual b - A x is the product and one subtraction: the product's sums to the bit.
-TEST_CASE("ch14: the pair lanes' fine residual is the padded columns' to the bit", "[ch14]") {
+TEST_CASE("ch14: the lanes' fine residual is the padded columns' to the bit", "[ch14]") {
   for (const std::string mesh : {"plate_poster.msh", "test_beam.msh"}) {
     INFO(mesh);
     auto stepper = stepped(mesh);
     auto& level = fine_level(*stepper);
-    ch14::LaneFineLevel lanes(level);
-    lanes.fill(0, lanes.blocks.rows());
-    const Written expected = run_fine(level, nullptr, 0, false, 1);
+    ch14::LaneFineLevel pairs(level);
+    ch14::RowPairFineLevel row_pairs(level);
+    pairs.fill(0, pairs.blocks.rows());
+    row_pairs.fill(0, row_pairs.blocks.rows());
+    const Written expected = run_fine<ch14::LaneFineLevel>(level, nullptr, 0, false, 1);
     for (const int threads : {1, 2}) {
       INFO(threads << " thread(s)");
-      CHECK(same_bits(run_fine(level, &lanes, 0, false, threads).residual, expected.residual));
+      CHECK(same_bits(run_fine(level, &pairs, 0, false, threads).residual, expected.residual));
+      CHECK(same_bits(run_fine(level, &row_pairs, 0, false, threads).residual, expected.residual));
     }
   }
 }
+
+namespace {
+
+// Steps 0, 1 and the last, from zero and from x, by `Lanes` against the padded columns.
+template <class Lanes>
+void check_smoothing(const std::string& mesh) {
+  auto stepper = stepped(mesh);
+  auto& level = fine_level(*stepper);
+  REQUIRE(stepper->multigrid().levels() >= 2);
+  Lanes lanes(level);
+  lanes.fill(0, lanes.blocks.rows());
+  const int steps = ch10::smoothing_steps(level);
+  const Eigen::VectorXf direction = level.vectors.direction;
+  for (const int k : {0, 1, steps - 1})
+    for (const bool from_zero : {true, false}) {
+      INFO(mesh << ", step " << k << (from_zero ? " from zero" : " from x"));
+      const Written expected = run_fine<Lanes>(level, nullptr, k, from_zero, 1);
+      const Written one = run_fine(level, &lanes, k, from_zero, 1);
+      const bool exact = from_zero || k == 0;
+      const float alpha = level.smoother.weights[2 * k];
+      const double terms = std::abs(alpha) * direction.cwiseAbs().maxCoeff() +
+                           expected.direction.cwiseAbs().maxCoeff();
+      CHECK((exact ? same_bits(one.direction, expected.direction)
+                   : (one.direction - expected.direction).cwiseAbs().maxCoeff() <=
+                         2.0 * FLT_EPSILON * terms));
+      CHECK((exact ? same_bits(one.y, expected.y)
+                   : worst(one.y, expected.y, expected.y) <= 4.0 * FLT_EPSILON));
+      const Written two = run_fine(level, &lanes, k, from_zero, 2);
+      CHECK(same_bits(two.y, one.y));
+      CHECK(same_bits(two.direction, one.direction));
+    }
+}
+
+}  // namespace
 
 // The step's update d = alpha d + beta D^-1 r is one multiply-add and a multiply: GCC fuses
 // one of the two multiplies with the add, and which one depends on the code around it, not
 // on the source. From zero, and in the first step, there is no alpha d: to the bit. After, to
 // the one rounding: within a float epsilon of the terms.
 TEST_CASE(
-    "ch14: the pair lanes' smoothing step is the padded columns' but for the update's "
-    "one rounding, the same on 1 and 2 threads",
+    "ch14: the lanes' smoothing step is the padded columns' but for the update's one "
+    "rounding, the same on 1 and 2 threads",
     "[ch14]") {
   for (const std::string mesh : {"plate_poster.msh", "test_beam.msh"}) {
-    auto stepper = stepped(mesh);
-    auto& level = fine_level(*stepper);
-    REQUIRE(stepper->multigrid().levels() >= 2);
-    ch14::LaneFineLevel lanes(level);
-    lanes.fill(0, lanes.blocks.rows());
-    const int steps = ch10::smoothing_steps(level);
-    const Eigen::VectorXf direction = level.vectors.direction;
-    for (const int k : {0, 1, steps - 1})
-      for (const bool from_zero : {true, false}) {
-        INFO(mesh << ", step " << k << (from_zero ? " from zero" : " from x"));
-        const Written expected = run_fine(level, nullptr, k, from_zero, 1);
-        const Written one = run_fine(level, &lanes, k, from_zero, 1);
-        const bool exact = from_zero || k == 0;
-        const float alpha = level.smoother.weights[2 * k];
-        const double terms = std::abs(alpha) * direction.cwiseAbs().maxCoeff() +
-                             expected.direction.cwiseAbs().maxCoeff();
-        CHECK((exact ? same_bits(one.direction, expected.direction)
-                     : (one.direction - expected.direction).cwiseAbs().maxCoeff() <=
-                           2.0 * FLT_EPSILON * terms));
-        CHECK((exact ? same_bits(one.y, expected.y)
-                     : worst(one.y, expected.y, expected.y) <= 4.0 * FLT_EPSILON));
-        const Written two = run_fine(level, &lanes, k, from_zero, 2);
-        CHECK(same_bits(two.y, one.y));
-        CHECK(same_bits(two.direction, one.direction));
-      }
+    SECTION("pair lanes " + mesh) { check_smoothing<ch14::LaneFineLevel>(mesh); }
+    SECTION("row pairs " + mesh) { check_smoothing<ch14::RowPairFineLevel>(mesh); }
   }
 }
 

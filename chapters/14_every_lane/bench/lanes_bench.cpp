@@ -67,14 +67,16 @@ struct Contest {
 };
 
 // The fine level's smoothing step (a step after the first, as the roofline times it) and
-// residual: the padded columns' (the V-cycle's own kernels) against the pair lanes'.
-std::vector<Contest> fine_contests(ch12::HalfBytesStepper& stepper, ch14::LaneFineLevel& lanes) {
+// residual: the padded columns' (the V-cycle's own kernels) against the lanes' (`name`).
+template <class Lanes>
+std::vector<Contest> fine_contests(ch12::HalfBytesStepper& stepper, Lanes& lanes,
+                                   const std::string& name) {
   auto& fine = lanes.level;
   const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
   const std::vector<ch10::LevelSize> levels = ch10::multigrid_levels(stepper.multigrid());
   PhaseWork old_step = ch10::v_cycle_work({levels.front()}, 1, sizeof(float), true).parts.front();
   const auto& part = source_level(fine).rows.part;
-  Contest smoothing{"fine smoothing step (float)", old_step, lanes.smoothing_work(),
+  Contest smoothing{"fine smoothing step (float), " + name, old_step, lanes.smoothing_work(),
                     [&fine, &part, step] {
                       ch09::for_parts(part, true, [&](int first, int last) {
                         ch10::smooth(fine, step, first, last, fine.vectors.b, &fine.vectors.x,
@@ -87,7 +89,7 @@ std::vector<Contest> fine_contests(ch12::HalfBytesStepper& stepper, ch14::LaneFi
                                           fine.vectors.y);
                       });
                     }};
-  Contest residual{"fine residual (float)", PhaseWork{}, lanes.residual_work(),
+  Contest residual{"fine residual (float), " + name, PhaseWork{}, lanes.residual_work(),
                    [&fine, &part] {
                      ch09::for_parts(part, true, [&](int first, int last) {
                        ch10::residual(fine, first, last, fine.vectors.b, fine.vectors.x);
@@ -120,7 +122,7 @@ Contest product_contest(const ch07::BlockSparseMatrix& A, const ch14::LaneProduc
   d->q = d->p;
   const double vector = 8.0 * double(d->p.size()), matrix = ch07::matrix_bytes(A);
   Contest c;
-  c.name = "product q = A p (double)";
+  c.name = "product q = A p (double), pair lanes";
   c.old_work = ch01::phase_work("product", matrix + vector, vector, vector,
                                 18.0 * double(A.blocks.size()), matrix + 2 * vector);
   c.new_work = lanes.work();
@@ -159,10 +161,13 @@ int main(int argc, char** argv) {
   if (!cycle || stepper.multigrid().levels() < 2) return 1;
   ch14::LaneFineLevel fine(cycle->fine_level());
   fine.fill(0, fine.blocks.rows());
+  ch14::RowPairFineLevel row_pairs(cycle->fine_level());
+  row_pairs.fill(0, row_pairs.blocks.rows());
   const ch07::BlockSparseMatrix& A = stepper.system_matrix();
   ch14::LaneProduct product(A);
   product.fill(A, 0, A.block_rows());
-  std::vector<Contest> contests = fine_contests(stepper, fine);
+  std::vector<Contest> contests = fine_contests(stepper, fine, "pair lanes");
+  for (Contest& c : fine_contests(stepper, row_pairs, "row pairs")) contests.push_back(c);
   contests.push_back(product_contest(A, product, std::make_shared<ProductData>()));
   std::printf("%s: %d nodes, %lld blocks\n", o.mesh.c_str(), A.block_rows(),
               static_cast<long long>(A.blocks.size()));
