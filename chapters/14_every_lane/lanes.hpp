@@ -45,10 +45,9 @@ struct GenericPairLanes {
     acc.even += Eigen::Map<const Half, Eigen::Aligned16>(a) * x[j];
   }
   // (c0 + c1) + c2 in each half, then even + odd: the order of the padded columns' total.
-  static Eigen::Matrix<Scalar, 3, 1> total(const Acc (&acc)[3]) {
-    const Half sum =
-        ((acc[0].even + acc[1].even) + acc[2].even) + ((acc[0].odd + acc[1].odd) + acc[2].odd);
-    return sum.template head<3>().matrix();
+  // Four lanes: the row's three sums and the padding row's (zero).
+  static Half total(const Acc (&acc)[3]) {
+    return ((acc[0].even + acc[1].even) + acc[2].even) + ((acc[0].odd + acc[1].odd) + acc[2].odd);
   }
 };
 
@@ -85,12 +84,13 @@ struct AvxFloatPairLanes {
                  Eigen::internal::pset1<Packet>(x[j])));
     acc = _mm256_blend_ps(acc, sum, 0x0F);  // the odd lanes keep their sums untouched
   }
-  static Eigen::Vector3f total(const Acc (&acc)[3]) {
+  static Eigen::Array4f total(const Acc (&acc)[3]) {
     using Eigen::internal::padd;
     const Packet sum = padd(padd(acc[0], acc[1]), acc[2]);
-    alignas(16) float out[4];
-    Eigen::internal::pstore(out, padd(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
-    return {out[0], out[1], out[2]};
+    Eigen::Array4f out;
+    Eigen::internal::pstoreu(out.data(),
+                             padd(_mm256_castps256_ps128(sum), _mm256_extractf128_ps(sum, 1)));
+    return out;
   }
 };
 template <class Scalar>
@@ -139,12 +139,13 @@ struct Avx512DoublePairLanes {
                  Eigen::internal::pset1<Packet>(x[j])));
     acc = _mm512_mask_blend_pd(0x0F, acc, sum);
   }
-  static Eigen::Vector3d total(const Acc (&acc)[3]) {
+  static Eigen::Array4d total(const Acc (&acc)[3]) {
     using Eigen::internal::padd;
     const Packet sum = padd(padd(acc[0], acc[1]), acc[2]);
-    alignas(32) double out[4];
-    Eigen::internal::pstore(out, padd(_mm512_castpd512_pd256(sum), _mm512_extractf64x4_pd(sum, 1)));
-    return {out[0], out[1], out[2]};
+    Eigen::Array4d out;
+    Eigen::internal::pstoreu(out.data(),
+                             padd(_mm512_castpd512_pd256(sum), _mm512_extractf64x4_pd(sum, 1)));
+    return out;
   }
 };
 template <>

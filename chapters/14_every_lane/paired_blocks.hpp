@@ -24,6 +24,7 @@ template <class Scalar>
 class PairedBlocks {
  public:
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
+  using Sum4 = Eigen::Array<Scalar, 4, 1>;
   static constexpr int kBlock = 12;  // scalars a block: 3 columns of 4
 
   PairedBlocks() = default;
@@ -36,15 +37,16 @@ class PairedBlocks {
 
   // sum of A_k x_(column k) over one row's blocks [begin, end); x holds 3 scalars per block
   // column. Reads one scalar past a column's 3 except at the last node's.
-  Vector3 row_product(int begin, int end, const Scalar* x) const;
+  // Four lanes: the row's three sums and a zero.
+  Sum4 row_sums(int begin, int end, const Scalar* x) const;
   Vector3 row_product(int i, const Scalar* x) const {
-    return row_product(row_start_[i], row_start_[i + 1], x);
+    return row_sums(row_start_[i], row_start_[i + 1], x).template head<3>().matrix();
   }
 
-  // f(i, row i's sum) for every row i in [first, last).
+  // f(i, row i's sums in four lanes) for every row i in [first, last).
   template <class F>
   void for_rows(int first, int last, const Scalar* x, F&& f) const {
-    for (int i = first; i < last; ++i) f(i, row_product(i, x));
+    for (int i = first; i < last; ++i) f(i, row_sums(row_start_[i], row_start_[i + 1], x));
   }
 
   int rows() const { return static_cast<int>(row_start_.size()) - 1; }
@@ -94,8 +96,8 @@ void PairedBlocks<Scalar>::fill(const Eigen::Matrix<Source, 3, 3>* values, int f
 }
 
 template <class Scalar>
-inline typename PairedBlocks<Scalar>::Vector3 PairedBlocks<Scalar>::row_product(
-    int begin, int end, const Scalar* x) const {
+inline typename PairedBlocks<Scalar>::Sum4 PairedBlocks<Scalar>::row_sums(int begin, int end,
+                                                                          const Scalar* x) const {
   const int paired_end = begin + ((end - begin) & ~1);
   const int* offset = x_offset_.data();
   // The last pair reads its odd piece with care if that is the last node (columns are

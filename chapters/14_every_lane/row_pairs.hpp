@@ -40,7 +40,7 @@ struct GenericRowPairLanes {
       Row::add<2>(acc.row[r][2], a + 32 + 8 * r, pieces);
     }
   }
-  static void totals(const Acc& acc, Eigen::Vector3f& first, Eigen::Vector3f& second) {
+  static void totals(const Acc& acc, Eigen::Array4f& first, Eigen::Array4f& second) {
     first = Row::total(acc.row[0]);
     second = Row::total(acc.row[1]);
   }
@@ -74,15 +74,13 @@ struct Avx512RowPairLanes {
     acc.column[2] = padd(acc.column[2], pmul(pload<Packet>(a + 32), _mm512_permute_ps(X, 0xAA)));
   }
   // Per row (c0 + c1) + c2 in each half, then even + odd: the padded columns' order.
-  static void totals(const Acc& acc, Eigen::Vector3f& first, Eigen::Vector3f& second) {
+  static void totals(const Acc& acc, Eigen::Array4f& first, Eigen::Array4f& second) {
     using Eigen::internal::padd;
     const Packet sum = padd(padd(acc.column[0], acc.column[1]), acc.column[2]);
     // lanes 4k..4k+3 + lanes of the neighbouring 128-bit piece: even + odd of each row
     const Packet both = padd(sum, _mm512_shuffle_f32x4(sum, sum, _MM_SHUFFLE(2, 3, 0, 1)));
-    alignas(64) float out[16];
-    Eigen::internal::pstore(out, both);
-    first = {out[0], out[1], out[2]};
-    second = {out[8], out[9], out[10]};
+    Eigen::internal::pstoreu(first.data(), _mm512_castps512_ps128(both));
+    Eigen::internal::pstoreu(second.data(), _mm512_extractf32x4_ps(both, 2));
   }
 };
 using RowPairLanes = Avx512RowPairLanes;
@@ -105,12 +103,12 @@ class RowPairBlocks {
 
   // The sums of row i (paired with i + 1 in its part; i is the pair's first row) and of row
   // i + 1, over their blocks; second is zero if i has no partner.
-  void row_products(int i, const float* x, Eigen::Vector3f& first, Eigen::Vector3f& second) const;
+  void row_products(int i, const float* x, Eigen::Array4f& first, Eigen::Array4f& second) const;
 
   // f(i, row i's sum) for every row i in [first, last) of whole row blocks, two at a time.
   template <class F>
   void for_rows(int first, int last, const float* x, F&& f) const {
-    Eigen::Vector3f sums[2];
+    Eigen::Array4f sums[2];
     for (int i = first; i < last; ++i) {
       row_products(i, x, sums[0], sums[1]);
       f(i, sums[0]);
@@ -156,8 +154,8 @@ void RowPairBlocks::fill(const Eigen::Matrix<Source, 3, 3>* values, int first, i
   }
 }
 
-inline void RowPairBlocks::row_products(int i, const float* x, Eigen::Vector3f& first,
-                                        Eigen::Vector3f& second) const {
+inline void RowPairBlocks::row_products(int i, const float* x, Eigen::Array4f& first,
+                                        Eigen::Array4f& second) const {
   const int g = group_[i];
   auto acc = RowPairLanes::zero();
   const float* a = values_.data() + std::size_t(kStep) * step_start_[g];
