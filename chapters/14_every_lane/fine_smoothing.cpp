@@ -155,7 +155,7 @@ PhaseWork LaneLevel<Blocks>::residual_work() const {
   return w;
 }
 
-template struct LaneLevel<PairedBlocks<float>>;
+template struct LaneLevel<PaddedFloatBlocks>;
 template struct LaneLevel<RowPairBlocks>;
 
 }  // namespace fem::ch14

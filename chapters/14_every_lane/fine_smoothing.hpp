@@ -28,8 +28,9 @@ using FloatLevel = ch12::ReducedLevel<float, 3>;
 using CoarseFloatLevel = ch12::ReducedLevel<float, ch10::kModes>;
 
 // The layout of a level's pattern (and its row blocks, for the row pairs).
-inline PairedBlocks<float> lanes_of(const ch10::Level<3>& level, const PairedBlocks<float>*) {
-  return PairedBlocks<float>(level.A);
+using PaddedFloatBlocks = PairedBlocks<float, false>;
+inline PaddedFloatBlocks lanes_of(const ch10::Level<3>& level, const PaddedFloatBlocks*) {
+  return PaddedFloatBlocks(level.A);
 }
 inline RowPairBlocks lanes_of(const ch10::Level<3>& level, const RowPairBlocks*) {
   return RowPairBlocks(level.A, level.rows.part);
@@ -60,8 +61,8 @@ struct LaneLevel : ch10::PolynomialLevel {
   ch10::WorkVectors<float>& vectors;
   Blocks blocks;
 };
-using LaneFineLevel = LaneLevel<PairedBlocks<float>>;  // the pair lanes
-using RowPairFineLevel = LaneLevel<RowPairBlocks>;     // the row pairs
+using LaneFineLevel = LaneLevel<PaddedFloatBlocks>;  // the pair lanes, padded
+using RowPairFineLevel = LaneLevel<RowPairBlocks>;   // the row pairs
 
 // Step k of the polynomial smoother on rows [first, last) of whole row blocks (from zero when
 // in is null): out and the level's direction written on those rows; every row of in must be

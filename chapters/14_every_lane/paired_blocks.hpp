@@ -1,15 +1,16 @@
 // A block compressed row matrix of 3x3 blocks stored for the pair lanes (lanes.hpp): each
 // block row's blocks taken two at a time from its first, a pair stored as its three columns,
-// each column as the two blocks' 4-row columns side by side (8 scalars, the 4th row zero); an
-// odd row's last block alone after its pairs (3 columns of 4). 12 scalars a block, so a row
-// starts at 12 times its first block's index: the products are found from the block range
-// [begin, end) alone, as the V-cycle's row_product is called, without a table of rows. (In
-// double a row then starts on a 64-byte line; in float on 16 bytes: the 256-bit loads are
-// unaligned.)
+// each column as the two blocks' columns side by side; an odd row's last block alone after
+// its pairs. Two layouts: padded, each column 4 scalars (the 4th zero), a pair's column one
+// whole-register load; packed, 3 (the block's own 36 bytes of float, 72 of double), a pair's
+// column joined from two loads of 4 (the 4th lane a harmless product, dropped). Which is
+// faster depends on what holds the kernel: the fine float level, held in the core on Zen 4
+// (its shuffles), is faster padded; the double product, held by its bytes, packed. A row
+// starts at kBlock times its first block's index: the products are found from the block
+// range [begin, end) alone, as the V-cycle's row_product is called, without a table of rows.
 //
 // The pattern and the layout are set up once; the values are copied in by rows (fill), every
 // step on the finest level, from the double blocks (a float copy rounds them as a cast does).
-// 48 bytes a float block against 36 unpadded: a third more bytes for whole-register loads.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,12 +21,15 @@
 
 namespace fem::ch14 {
 
-template <class Scalar>
+template <class Scalar, bool Packed>
 class PairedBlocks {
  public:
   using Vector3 = Eigen::Matrix<Scalar, 3, 1>;
   using Sum4 = Eigen::Array<Scalar, 4, 1>;
-  static constexpr int kBlock = 12;  // scalars a block: 3 columns of 4
+  // Scalars a block: 3 columns of 3 (packed) or of 4 (padded); in a pair, one column of
+  // both blocks every kColumn scalars, the odd block's kOdd on.
+  static constexpr int kBlock = Packed ? 9 : 12;
+  static constexpr int kColumn = Packed ? 6 : 8, kOdd = Packed ? 3 : 4;
 
   PairedBlocks() = default;
   // The layout of `pattern`'s blocks (values zero).
@@ -58,9 +62,15 @@ class PairedBlocks {
  private:
   using Lanes = PairLanes<Scalar>;
   void add_pair(typename Lanes::Acc (&acc)[3], const Scalar* a, const typename Lanes::X& x) const {
-    Lanes::template add<0>(acc[0], a, x);
-    Lanes::template add<1>(acc[1], a + 8, x);
-    Lanes::template add<2>(acc[2], a + 16, x);
+    if constexpr (Packed) {
+      Lanes::template add_packed<0>(acc[0], a, x);
+      Lanes::template add_packed<1>(acc[1], a + kColumn, x);
+      Lanes::template add_packed<2>(acc[2], a + 2 * kColumn, x);
+    } else {
+      Lanes::template add_padded<0>(acc[0], a, x);
+      Lanes::template add_padded<1>(acc[1], a + kColumn, x);
+      Lanes::template add_padded<2>(acc[2], a + 2 * kColumn, x);
+    }
   }
 
   std::vector<Scalar, Eigen::aligned_allocator<Scalar>> values_;
@@ -71,23 +81,24 @@ class PairedBlocks {
 
 // ---- definitions of the templates -----------------------------------------------------
 
-template <class Scalar>
-PairedBlocks<Scalar>::PairedBlocks(const ch07::BlockCsr<3, 3>& pattern)
-    : values_(kBlock * pattern.column.size(), Scalar(0)), row_start_(pattern.row_start) {
+template <class Scalar, bool Packed>
+PairedBlocks<Scalar, Packed>::PairedBlocks(const ch07::BlockCsr<3, 3>& pattern)
+    : values_(kBlock * pattern.column.size() + 1, Scalar(0)), row_start_(pattern.row_start) {
   x_offset_.resize(pattern.column.size());
   for (std::size_t k = 0; k < pattern.column.size(); ++k) x_offset_[k] = 3 * pattern.column[k];
   last_x_offset_ = 3 * (pattern.block_rows() - 1);
 }
 
-template <class Scalar>
+template <class Scalar, bool Packed>
 template <class Source>
-void PairedBlocks<Scalar>::fill(const Eigen::Matrix<Source, 3, 3>* values, int first, int last) {
+void PairedBlocks<Scalar, Packed>::fill(const Eigen::Matrix<Source, 3, 3>* values, int first,
+                                        int last) {
   for (int i = first; i < last; ++i) {
     const int begin = row_start_[i], end = row_start_[i + 1], paired = (end - begin) & ~1;
     for (int r = 0; r < end - begin; ++r) {
-      // A pair's column j at 8 j, its odd block 4 scalars on; a single's column j at 4 j.
-      Scalar* a = values_.data() + kBlock * (begin + r - r % 2) + (r < paired ? r % 2 * 4 : 0);
-      const int stride = r < paired ? 8 : 4;
+      // A pair's column j at kColumn j, its odd block kOdd on; a single's column j at kOdd j.
+      Scalar* a = values_.data() + kBlock * (begin + r - r % 2) + (r < paired ? r % 2 * kOdd : 0);
+      const int stride = r < paired ? kColumn : kOdd;
       for (int j = 0; j < 3; ++j)
         for (int row = 0; row < 3; ++row)
           a[stride * j + row] = static_cast<Scalar>(values[begin + r](row, j));
@@ -95,9 +106,9 @@ void PairedBlocks<Scalar>::fill(const Eigen::Matrix<Source, 3, 3>* values, int f
   }
 }
 
-template <class Scalar>
-inline typename PairedBlocks<Scalar>::Sum4 PairedBlocks<Scalar>::row_sums(int begin, int end,
-                                                                          const Scalar* x) const {
+template <class Scalar, bool Packed>
+inline typename PairedBlocks<Scalar, Packed>::Sum4 PairedBlocks<Scalar, Packed>::row_sums(
+    int begin, int end, const Scalar* x) const {
   const int paired_end = begin + ((end - begin) & ~1);
   const int* offset = x_offset_.data();
   // The last pair reads its odd piece with care if that is the last node (columns are
@@ -116,14 +127,14 @@ inline typename PairedBlocks<Scalar>::Sum4 PairedBlocks<Scalar>::row_sums(int be
   }
   if (k < end) {
     Lanes::template add_even<0>(acc[0], a, x + offset[k]);
-    Lanes::template add_even<1>(acc[1], a + 4, x + offset[k]);
-    Lanes::template add_even<2>(acc[2], a + 8, x + offset[k]);
+    Lanes::template add_even<1>(acc[1], a + kOdd, x + offset[k]);
+    Lanes::template add_even<2>(acc[2], a + 2 * kOdd, x + offset[k]);
   }
   return Lanes::total(acc);
 }
 
-template <class Scalar>
-double PairedBlocks<Scalar>::bytes() const {
+template <class Scalar, bool Packed>
+double PairedBlocks<Scalar, Packed>::bytes() const {
   return double(values_.size()) * sizeof(Scalar) +
          double(x_offset_.size() + row_start_.size()) * sizeof(int);
 }

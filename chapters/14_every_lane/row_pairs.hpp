@@ -35,9 +35,9 @@ struct GenericRowPairLanes {
   static void add(Acc& acc, const float* a, const float* const (&x)[4]) {
     for (int r = 0; r < 2; ++r) {
       const Row::X pieces = Row::pair(x[2 * r], x[2 * r + 1]);
-      Row::add<0>(acc.row[r][0], a + 8 * r, pieces);
-      Row::add<1>(acc.row[r][1], a + 16 + 8 * r, pieces);
-      Row::add<2>(acc.row[r][2], a + 32 + 8 * r, pieces);
+      Row::add_padded<0>(acc.row[r][0], a + 8 * r, pieces);
+      Row::add_padded<1>(acc.row[r][1], a + 16 + 8 * r, pieces);
+      Row::add_padded<2>(acc.row[r][2], a + 32 + 8 * r, pieces);
     }
   }
   static void totals(const Acc& acc, Eigen::Array4f& first, Eigen::Array4f& second) {

@@ -115,14 +115,15 @@ struct ProductData {
   Eigen::VectorXd p, q;
 };
 
-Contest product_contest(const ch07::BlockSparseMatrix& A, const ch14::LaneProduct& lanes,
-                        std::shared_ptr<ProductData> d) {
+template <class Lanes>
+Contest product_contest(const ch07::BlockSparseMatrix& A, const Lanes& lanes,
+                        std::shared_ptr<ProductData> d, const std::string& name) {
   d->chunks = ch09::RowChunks(A);
   d->p = Eigen::VectorXd::LinSpaced(3 * A.block_rows(), 1e-3, 1.0);
   d->q = d->p;
   const double vector = 8.0 * double(d->p.size()), matrix = ch07::matrix_bytes(A);
   Contest c;
-  c.name = "product q = A p (double), pair lanes";
+  c.name = "product q = A p (double), " + name;
   c.old_work = ch01::phase_work("product", matrix + vector, vector, vector,
                                 18.0 * double(A.blocks.size()), matrix + 2 * vector);
   c.new_work = lanes.work();
@@ -166,9 +167,14 @@ int main(int argc, char** argv) {
   const ch07::BlockSparseMatrix& A = stepper.system_matrix();
   ch14::LaneProduct product(A);
   product.fill(A, 0, A.block_rows());
+  ch14::PaddedLaneProduct padded(A);
+  padded.fill(A, 0, A.block_rows());
   std::vector<Contest> contests = fine_contests(stepper, fine, "pair lanes");
   for (Contest& c : fine_contests(stepper, row_pairs, "row pairs")) contests.push_back(c);
-  contests.push_back(product_contest(A, product, std::make_shared<ProductData>()));
+  contests.push_back(
+      product_contest(A, product, std::make_shared<ProductData>(), "pair lanes, packed"));
+  contests.push_back(
+      product_contest(A, padded, std::make_shared<ProductData>(), "pair lanes, padded"));
   std::printf("%s: %d nodes, %lld blocks\n", o.mesh.c_str(), A.block_rows(),
               static_cast<long long>(A.blocks.size()));
   const int max_threads = openmp_enabled() ? 2 : 1;
