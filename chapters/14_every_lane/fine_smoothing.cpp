@@ -37,40 +37,71 @@ void update_row(LaneLevel<Blocks>& level, int i, const Eigen::Vector3f& sum, con
     out.segment<3>(3 * i) = next;
 }
 
-using Piece = Eigen::Map<const Eigen::Array4f>;  // a node's 3 floats and the next one
-using Store = Eigen::Map<Eigen::Array3f>;
+#if defined(EIGEN_VECTORIZE_SSE)
+// The update in four lanes on SSE and wider: a vector operation a step instead of three
+// scalar ones, the same roundings per lane. Written in Eigen's packets, not in Array4f: on
+// an Array4f GCC takes a lane (r[j]) or the first three (head<3>) through the stack, a store
+// and loads that wait for it on every row's chain.
+using Eigen::internal::Packet4f;
 
-// D_i^-1 r in four lanes as the float level computes it (a sum per column from zero, then
-// (c0 + c1) + c2: the same roundings); the lanes past the third are dropped. The inverse
-// diagonals end with a padding block: the third column's 4th float exists.
-EIGEN_ALWAYS_INLINE Eigen::Array4f inverse_times(const FloatLevel& level, int i,
-                                                 const Eigen::Array4f& r) {
-  const float* D = level.smoother.inverse_diagonal[i].data();
-  Eigen::Array4f c0 = Eigen::Array4f::Zero(), c1 = c0, c2 = c0;
-  c0 += Piece(D) * r[0];
-  c1 += Piece(D + 3) * r[1];
-  c2 += Piece(D + 6) * r[2];
-  return (c0 + c1) + c2;
+template <int j>
+EIGEN_ALWAYS_INLINE Packet4f splat(const Packet4f& v) {
+  return _mm_shuffle_ps(v, v, j * 0x55);
+}
+
+// The first 3 lanes of v at p: the low 2, then the 3rd.
+EIGEN_ALWAYS_INLINE void store3(float* p, const Packet4f& v) {
+  _mm_storel_pi(reinterpret_cast<__m64*>(p), v);
+  _mm_store_ss(p + 2, _mm_movehl_ps(v, v));
+}
+
+// D_i^-1 r as the float level computes it: a sum per column from zero, then (c0 + c1) + c2
+// (the same roundings). The inverse diagonals end with a padding block: the third column's
+// 4th float exists.
+EIGEN_ALWAYS_INLINE Packet4f inverse_times(const float* D, const Packet4f& r) {
+  using namespace Eigen::internal;
+  const Packet4f zero = pset1<Packet4f>(0.0f);
+  const Packet4f c0 = padd(zero, pmul(ploadu<Packet4f>(D), splat<0>(r)));
+  const Packet4f c1 = padd(zero, pmul(ploadu<Packet4f>(D + 3), splat<1>(r)));
+  const Packet4f c2 = padd(zero, pmul(ploadu<Packet4f>(D + 6), splat<2>(r)));
+  return padd(padd(c0, c1), c2);
 }
 
 // update_row in four lanes, for every row but the last (whose 4th floats lie past b, in and
-// d): a vector operation a step instead of three scalar ones, the same roundings per lane.
+// d).
 template <class Blocks>
 EIGEN_ALWAYS_INLINE void update_row4(LaneLevel<Blocks>& level, int i, const Eigen::Array4f& sum,
                                      const Weights& w, const Eigen::VectorXf& b,
                                      const Eigen::VectorXf* in, Eigen::VectorXf& out) {
-  Eigen::Array4f r = Piece(b.data() + 3 * i);
-  if (in) r -= sum;
-  const Eigen::Array4f t = inverse_times(level.level, i, r);
+  using namespace Eigen::internal;
+  Packet4f r = ploadu<Packet4f>(b.data() + 3 * i);
+  if (in) r = psub(r, ploadu<Packet4f>(sum.data()));
+  const Packet4f t = inverse_times(level.level.smoother.inverse_diagonal[i].data(), r);
   float* d = level.vectors.direction.data() + 3 * i;
-  const Eigen::Array4f next =
-      w.restart ? Eigen::Array4f(w.beta * t) : Eigen::Array4f(w.alpha * Piece(d) + w.beta * t);
-  Store{d} = next.head<3>();
-  if (in)
-    Store{out.data() + 3 * i} = (Piece(in->data() + 3 * i) + next).head<3>();
-  else
-    Store{out.data() + 3 * i} = next.head<3>();
+  const Packet4f scaled = pmul(pset1<Packet4f>(w.beta), t);
+  const Packet4f next =
+      w.restart ? scaled : padd(pmul(pset1<Packet4f>(w.alpha), ploadu<Packet4f>(d)), scaled);
+  store3(d, next);
+  store3(out.data() + 3 * i, in ? padd(ploadu<Packet4f>(in->data() + 3 * i), next) : next);
 }
+
+template <class Blocks>
+EIGEN_ALWAYS_INLINE void update(LaneLevel<Blocks>& level, int i, const Eigen::Array4f& sum,
+                                const Weights& w, const Eigen::VectorXf& b,
+                                const Eigen::VectorXf* in, Eigen::VectorXf& out) {
+  if (i + 1 < level.blocks.rows())
+    update_row4(level, i, sum, w, b, in, out);
+  else
+    update_row(level, i, sum.head<3>().matrix(), w, b, in, out);
+}
+#else
+template <class Blocks>
+EIGEN_ALWAYS_INLINE void update(LaneLevel<Blocks>& level, int i, const Eigen::Array4f& sum,
+                                const Weights& w, const Eigen::VectorXf& b,
+                                const Eigen::VectorXf* in, Eigen::VectorXf& out) {
+  update_row(level, i, sum.head<3>().matrix(), w, b, in, out);
+}
+#endif
 
 }  // namespace
 
@@ -78,18 +109,12 @@ template <class Blocks>
 void smooth_rows(LaneLevel<Blocks>& level, int k, int first, int last, const Eigen::VectorXf& b,
                  const Eigen::VectorXf* in, Eigen::VectorXf& out) {
   const Weights w{level.smoother.weights[2 * k], level.smoother.weights[2 * k + 1], k == 0 || !in};
-  const int last_row = level.blocks.rows() - 1;
-  const auto update = [&](int i, const Eigen::Array4f& sum) {
-    if (i < last_row)
-      update_row4(level, i, sum, w, b, in, out);
-    else
-      update_row(level, i, sum.head<3>().matrix(), w, b, in, out);
-  };
+  const auto row = [&](int i, const Eigen::Array4f& sum) { update(level, i, sum, w, b, in, out); };
   if (in) {
-    level.blocks.for_rows(first, last, in->data(), update);
+    level.blocks.for_rows(first, last, in->data(), row);
     return;
   }
-  for (int i = first; i < last; ++i) update(i, Eigen::Array4f::Zero());
+  for (int i = first; i < last; ++i) row(i, Eigen::Array4f::Zero());
 }
 
 template <class Blocks>
