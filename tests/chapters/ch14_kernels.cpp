@@ -12,6 +12,7 @@
 #include "catch2_compat.hpp"
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
+#include "chapters/10_multigrid/v_cycle.hpp"
 #include "chapters/12_half_the_bytes/reduced_kernels.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/14_every_lane/fine_smoothing.hpp"
@@ -210,6 +211,26 @@ TEST_CASE(
     SECTION("packed " + mesh) { check_product<ch14::LaneProduct>(mesh); }
     SECTION("padded " + mesh) { check_product<ch14::PaddedLaneProduct>(mesh); }
   }
+}
+
+// The lanes' fine level is a level of the V-cycle: a whole cycle on it (with the float coarse
+// levels below) is the float V-cycle's to float rounding, and the same on 1 and 2 threads.
+TEST_CASE("ch14: a whole V-cycle on the lanes' fine level is the float V-cycle's to rounding",
+          "[ch14]") {
+  auto stepper = stepped("plate_poster.msh");
+  auto* cycle = dynamic_cast<ch12::ReducedVCycle<float>*>(&stepper->v_cycle());
+  REQUIRE(cycle != nullptr);
+  auto& fine = cycle->fine_level();
+  auto& coarse = cycle->coarse_levels();
+  ch14::LaneFineLevel lanes(fine);
+  lanes.fill(0, lanes.blocks.rows());
+  const Eigen::VectorXf r = fine.vectors.b;
+  Eigen::VectorXf expected(r.size()), one(r.size()), two(r.size());
+  on_team(1, [&] { ch10::v_cycle(fine, coarse, 0, r, expected, true); });
+  on_team(1, [&] { ch10::v_cycle(lanes, coarse, 0, r, one, true); });
+  on_team(2, [&] { ch10::v_cycle(lanes, coarse, 0, r, two, true); });
+  CHECK((one - expected).norm() <= 1e-5 * expected.norm());
+  CHECK(same_bits(one, two));
 }
 
 TEST_CASE("ch14: the lanes' kernels allocate nothing per call, on 2 threads", "[ch14]") {
