@@ -143,10 +143,14 @@ void report(const Contest& c, int threads, const roofline::Roofs& roofs, double 
   const bool roofed = !roofs.levels.empty();
   const double old_bound = roofed ? roofline::bound_seconds(roofs, c.old_work) : 0.0;
   const double new_bound = roofed ? roofline::bound_seconds(roofs, c.new_work) : 0.0;
-  std::printf("| %s | %d | %.2f | %.2f | %.3f | %.2f / %.2f | %.0f%% | %.0f%% | %.0f%% |\n",
-              c.name.c_str(), threads, 1e6 * old_s, 1e6 * new_s, new_s / old_s, 1e6 * old_bound,
-              1e6 * new_bound, 100 * old_bound / old_s, 100 * new_bound / new_s,
-              100 * old_bound / new_s);
+  const char* level =
+      roofed ? roofline::fitting_level(roofs, c.new_work.working_set).level.name.c_str() : "-";
+  std::printf(
+      "| %s | %d | %.2f | %.2f | %.3f | %.0f / %.0f | %s | %.2f / %.2f | %.0f%% | %.0f%% | "
+      "%.0f%% |\n",
+      c.name.c_str(), threads, 1e6 * old_s, 1e6 * new_s, new_s / old_s, 1e-3 * c.old_work.bytes(),
+      1e-3 * c.new_work.bytes(), level, 1e6 * old_bound, 1e6 * new_bound, 100 * old_bound / old_s,
+      100 * new_bound / new_s, 100 * old_bound / new_s);
 }
 
 }  // namespace
@@ -179,8 +183,9 @@ int main(int argc, char** argv) {
               static_cast<long long>(A.blocks.size()));
   const int max_threads = openmp_enabled() ? 2 : 1;
   std::printf(
-      "| kernel | threads | old us | new us | new/old | bound old / new us | old of its bound | "
-      "new of its bound | new of old's bound |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| kernel | threads | old us | new us | new/old | kB old / new | level (new) | bound old / "
+      "new us | old of its bound | new of its bound | new of old's bound |\n"
+      "|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|\n");
   for (int threads = 1; threads <= max_threads; ++threads) {
     if (o.threads > 0 && threads != o.threads) continue;
     // --roof-seconds 0: no roofs (the kernels' times and ratios only, quickly).
@@ -188,6 +193,9 @@ int main(int argc, char** argv) {
         o.roof_seconds > 0
             ? roofline::measure_roofs(roofline::cache_levels(), threads, o.roof_seconds, false)
             : roofline::Roofs{};
+    for (const roofline::LevelRoof& l : roofs.levels)
+      std::printf("%d thread(s): %s read roof %.1f GB/s\n", threads, l.level.name.c_str(),
+                  1e-9 * l.read);
     for (const Contest& c : contests) {
       double old_s = 1e30, new_s = 1e30;
       for (int round = 0; round < o.rounds; ++round) {
