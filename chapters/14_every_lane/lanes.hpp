@@ -1,10 +1,11 @@
 // The vector lanes of a pair of 3x3 blocks: two blocks of one block row side by side in one
-// register, each block's column padded to 4 rows (lanes 0-3 the row's even block, lanes 4-7
-// its odd one). A 3x3 block alone fills 3 of 4 lanes of a 128-bit register and leaves the rest
-// of a 256- or 512-bit one idle; two blocks per register fill 8 lanes of float (256 bits) or
-// of double (512 bits) with the same instructions. The x of the two blocks is loaded as two
-// 4-scalar pieces and each column's entry is spread over its block's 4 lanes by an in-lane
-// permute: no gather (slow on some cores: AMD's Zen 4 issues one per several cycles).
+// register, each block's column in 4 lanes (lanes 0-3 the row's even block, lanes 4-7 its odd
+// one; the 4th lane of each a padding row, zero or a dropped product). A 3x3 block alone fills 3 of
+// 4 lanes of a 128-bit register and leaves the rest of a 256- or 512-bit one idle; two blocks per
+// register fill 8 lanes of float (256 bits) or of double (512 bits) with the same instructions. The
+// x of the two blocks is loaded as two 4-scalar pieces and each column's entry is spread over its
+// block's 4 lanes by an in-lane permute: no gather (slow on some cores: AMD's Zen 4 issues one per
+// several cycles).
 //
 // The even and odd lanes keep apart the two partial sums that the scalar-per-block products
 // keep (the even and the odd blocks of a row), and a sum per block column: the same
