@@ -153,6 +153,19 @@ void report(const Contest& c, int threads, const roofline::Roofs& roofs, double 
       100 * new_bound / new_s, 100 * old_bound / new_s);
 }
 
+// The set-up each step adds: the values copied into the lanes (by rows, every thread).
+void time_fills(ch14::LaneFineLevel& fine, ch14::LaneProduct& product,
+                const ch07::BlockSparseMatrix& A) {
+  const double fine_fill = roofline::best_call_seconds(1, [&fine] {
+    for (const int c : ch09::StaticShare(fine.blocks.rows())) fine.fill(c, c + 1);
+  });
+  const double product_fill = roofline::best_call_seconds(1, [&product, &A] {
+    for (const int c : ch09::StaticShare(A.block_rows())) product.fill(A, c, c + 1);
+  });
+  std::printf("fill at 1 thread: fine level %.2f us, product %.2f us\n", 1e6 * fine_fill,
+              1e6 * product_fill);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -205,15 +218,7 @@ int main(int argc, char** argv) {
       report(c, threads, roofs, old_s, new_s);
     }
   }
-  // The set-up each step adds: the values copied into the lanes (by rows, every thread).
-  const double fine_fill = roofline::best_call_seconds(1, [&fine] {
-    for (const int c : ch09::StaticShare(fine.blocks.rows())) fine.fill(c, c + 1);
-  });
-  const double product_fill = roofline::best_call_seconds(1, [&product, &A] {
-    for (const int c : ch09::StaticShare(A.block_rows())) product.fill(A, c, c + 1);
-  });
-  std::printf("fill at 1 thread: fine level %.2f us, product %.2f us\n", 1e6 * fine_fill,
-              1e6 * product_fill);
+  time_fills(fine, product, A);
   std::printf("load after: %s\n", load_average().c_str());
   return 0;
 }
