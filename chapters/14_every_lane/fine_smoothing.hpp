@@ -1,9 +1,10 @@
 // The V-cycle's finest level in float with its products in vector lanes filled across blocks:
 // the polynomial smoothing step and the residual, which the V-cycle runs on it some twelve
 // times per cycle, and which alone took two thirds of a step with a quarter of the lanes busy.
-// Two layouts: a row's blocks in pairs (paired_blocks.hpp, 256-bit registers: the faster on
-// AMD's Zen 4, whose 512-bit shuffles take two passes) and two rows' pairs side by side
-// (row_pairs.hpp, 512-bit registers, for cores with full-width shuffles: measure).
+// Two layouts: a row's blocks in pairs (paired_blocks.hpp, 256-bit registers) and two rows'
+// pairs side by side (row_pairs.hpp, 512-bit registers, three 128-bit inserts and three
+// permutes of 512 bits per four blocks). On the AMD EPYC this was measured on (family 26 by
+// its cpuid: Zen 5) the pairs are the faster by far (lanes_bench); measure on other cores.
 //
 // A part for a stepper: a level type of the V-cycle (v_cycle.hpp's interface, found by
 // argument-dependent lookup) that views a float level (its inverse diagonal, weights and

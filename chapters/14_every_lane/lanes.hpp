@@ -4,8 +4,8 @@
 // 4 lanes of a 128-bit register and leaves the rest of a 256- or 512-bit one idle; two blocks per
 // register fill 8 lanes of float (256 bits) or of double (512 bits) with the same instructions. The
 // x of the two blocks is loaded as two 4-scalar pieces and each column's entry is spread over its
-// block's 4 lanes by an in-lane permute: no gather (slow on some cores: AMD's Zen 4 issues one per
-// several cycles).
+// block's 4 lanes by an in-lane permute: no gather (slow on some cores: on the AMD EPYC this
+// was measured on, three 16-lane gathers a slot made the product slower than without lanes).
 //
 // The even and odd lanes keep apart the two partial sums that the scalar-per-block products
 // keep (the even and the odd blocks of a row), and a sum per block column: the same
@@ -85,7 +85,8 @@ struct AvxFloatPairLanes {
     add_column<j>(acc, Eigen::internal::ploadu<Packet>(a), x);
   }
   // Packed: the two blocks' 3 floats joined from two loads of 4. (AVX-512's expanding load
-  // would spread them without the join, but on Zen 4 it made the product half as fast.)
+  // would spread them without the join, but on the AMD EPYC measured it made the product
+  // half as fast.)
   template <int j>
   static void add_packed(Acc& acc, const float* a, const X& x) {
     using Eigen::internal::Packet4f;

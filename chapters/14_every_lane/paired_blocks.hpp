@@ -4,8 +4,8 @@
 // its pairs. Two layouts: padded, each column 4 scalars (the 4th zero), a pair's column one
 // whole-register load; packed, 3 (the block's own 36 bytes of float, 72 of double), a pair's
 // column joined from two loads of 4 (the 4th lane a harmless product, dropped). Which is
-// faster depends on what holds the kernel: the fine float level, held in the core on Zen 4
-// (its shuffles), is faster padded; the double product, held by its bytes, packed. A row
+// faster depends on what holds the kernel: on the AMD EPYC measured, the fine float level,
+// held in the core, is faster padded; the double product, held by its bytes, packed. A row
 // starts at kBlock times its first block's index: the products are found from the block
 // range [begin, end) alone, as the V-cycle's row_product is called, without a table of rows.
 //
