@@ -73,7 +73,8 @@ std::vector<Contest> fine_contests(ch12::HalfBytesStepper& stepper, Lanes& lanes
                                    const std::string& name) {
   auto& fine = lanes.level;
   const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
-  const std::vector<ch10::LevelSize> levels = ch10::multigrid_levels(stepper.multigrid());
+  const std::vector<ch10::LevelSize> levels =
+      ch10::multigrid_levels(stepper.preconditioner().multigrid());
   PhaseWork old_step = ch10::v_cycle_work({levels.front()}, 1, sizeof(float), true).parts.front();
   const auto& part = source_level(fine).rows.part;
   Contest smoothing{"fine smoothing step (float), " + name, old_step, lanes.smoothing_work(),
@@ -175,8 +176,8 @@ int main(int argc, char** argv) {
   ch12::HalfBytesStepper stepper(scene, SolverSettings{});
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
-  auto* cycle = dynamic_cast<ch12::ReducedVCycle<float>*>(&stepper.v_cycle());
-  if (!cycle || stepper.multigrid().levels() < 2) return 1;
+  ch12::ReducedVCycle<float>* cycle = &stepper.preconditioner().v_cycle();
+  if (!cycle || stepper.preconditioner().multigrid().levels() < 2) return 1;
   ch14::LaneFineLevel fine(cycle->fine_level());
   fine.fill(0, fine.blocks.rows());
   ch14::RowPairFineLevel row_pairs(cycle->fine_level());
