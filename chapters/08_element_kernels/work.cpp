@@ -22,9 +22,8 @@ ElementWork fused_pass_work(const WorkInput& in) {
   // above glibc's threshold) need not read the lines first: A's bytes are written, not
   // allocated, so that the bound stays below what any core pays (a Zen 5 ran the plate's
   // compose at 107% of the bound that charged them).
-  const PhaseWork compose =
-      ch01::phase_work("compose", m.nodes * sizeof(int) + 4 * v, blocks + v, v, 4 * m.dofs,
-                       blocks + m.nodes * sizeof(int) + 5 * v);
+  const PhaseWork compose = ch01::phase_work("compose", m.nodes * sizeof(int) + 4 * v, blocks + v,
+                                             v, 4 * m.dofs, blocks + m.nodes * sizeof(int) + 5 * v);
   // The fused pass: per element its shape, its last two rotations (both written back), its
   // corners and block positions; x and v; every block of A and b read and added into.
   const double per_element = sizeof(ElementShape) + 2 * sizeof(Eigen::Quaterniond) +
