@@ -24,7 +24,8 @@ PAUSED = "paused"
 
 def chapter_ids():
     """Every chapter directory, in order (the same names fem_viewer --chapter takes)."""
-    return sorted(d.name for d in (ROOT / "chapters").glob("[0-9][0-9]_*") if d.is_dir())
+    return sorted(d.name for d in (ROOT / "chapters").glob("[0-9][0-9]_*")
+                  if d.is_dir() and (d / "stepper.hpp").exists())  # a chapter has a stepper
 
 
 def git_commit():
