@@ -74,9 +74,11 @@ def phase_problem(p, with_waiting):
 # A known gap of the model, not of a run (issue 56 prices writes anew): compose zeroes A by
 # memset, whose whole-line stores (rep stosb, non-temporal above glibc's threshold) beat the
 # write roof that the roofline's write kernel measures with plain vector stores; on an AMD EPYC
-# (Zen 5) the plate's compose ran at 100-114% of its bound at one thread. Until the roofs measure
-# such stores, a compose phase may run this much faster than its bound before it is refused.
-MEMSET_SLACK = 1.25
+# (Zen 5) the plate's compose ran at 100-114% of its bound at one thread, and the 82k-node beam's
+# at 177% at two (glibc's non-temporal stores above its threshold skip the write roof's line
+# reads in memory). Until the roofs measure such stores, a compose phase may run this much faster
+# than its bound before it is refused.
+MEMSET_SLACK = 2.0
 
 
 def problems(data):
