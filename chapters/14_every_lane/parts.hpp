@@ -1,0 +1,41 @@
+// Chapter 14's part: chapter 12's float V-cycle with its finest level in pair lanes
+// (lane_v_cycle.hpp), where two thirds of the interactive step went to one kernel with three of
+// a core's four vector lanes idle.
+#pragma once
+
+#include <ostream>
+
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/14_every_lane/lane_v_cycle.hpp"
+
+namespace fem::ch14 {
+
+// Preconditioner: chapter 12's hierarchy in float, its finest level's products in pair lanes.
+class LaneMultigrid {
+ public:
+  using Params = ch10::MultigridSettings;
+  static constexpr const char* kName =
+      "one V-cycle on float numbers, the finest level in pair lanes";
+  static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
+
+  LaneMultigrid(const ch08::PartSetup& setup, const Params& params)
+      : reduced_(setup, params), lanes_(reduced_.v_cycle(), reduced_.multigrid()) {}
+  ch09::Preconditioner& pcg_preconditioner() { return lanes_; }
+  LaneVCycle& lane_v_cycle() { return lanes_; }
+  const LaneVCycle& lane_v_cycle() const { return lanes_; }
+  ch10::Multigrid& multigrid() { return reduced_.multigrid(); }
+  const ch10::Multigrid& multigrid() const { return reduced_.multigrid(); }
+  void describe(std::ostream& out) const {
+    reduced_.describe(out);
+    if (lanes_.lanes())
+      out << "    finest level in pair lanes: " << lanes_.fine_level().blocks.bytes() / 1024
+          << " KiB\n";
+  }
+
+ private:
+  ch12::ReducedMultigrid<float> reduced_;  // chapter 12's levels and their conversion
+  LaneVCycle lanes_;                       // reads reduced_: declared after it
+};
+
+}  // namespace fem::ch14

@@ -1,0 +1,26 @@
+// Chapter 14: every vector lane busy. Chapter 12's step with the V-cycle's finest level in
+// pair lanes (lane_v_cycle.hpp): two 3x3 blocks of a row side by side in one register, where
+// chapter 12 loads one block's column into four of a register's eight or sixteen lanes.
+#pragma once
+
+#include "chapters/08_element_kernels/step.hpp"
+#include "chapters/09_threads/parts.hpp"
+#include "chapters/10_multigrid/parts.hpp"
+#include "chapters/11_node_order/renumbered_nodes.hpp"
+#include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/14_every_lane/parts.hpp"
+
+namespace fem::ch14 {
+
+struct EveryLane {
+  using Order = ch11::RenumberedNodes;        // chapter 11's
+  using Team = ch09::TeamOfThreads;           // chapter 09's
+  using Elements = ch12::BatchedElementPass;  // chapter 12's
+  using Guess = ch10::Extrapolation;          // chapter 10's
+  using Preconditioner = LaneMultigrid;       // new: the finest level in pair lanes
+  using Solver = ch09::ParallelPcgSolver;     // chapter 09's
+};
+
+using EveryLaneStepper = ch08::StepOf<EveryLane>;
+
+}  // namespace fem::ch14

@@ -1,0 +1,61 @@
+#include "chapters/14_every_lane/work.hpp"
+
+#include <algorithm>
+
+#include "chapters/09_threads/parallel.hpp"
+#include "chapters/10_multigrid/smoothers.hpp"
+#include "chapters/10_multigrid/work.hpp"
+
+namespace fem::ch14 {
+
+namespace {
+
+// The finest level's matrix as chapter 10 counts a level's (work.cpp, level_product): 3x3
+// blocks of float, an index a block and a start a row.
+double float_blocks_bytes(const LaneFineLevel& fine) {
+  const double blocks = double(fine.blocks.blocks()), rows = fine.blocks.rows();
+  return 9.0 * sizeof(float) * blocks + 4.0 * (blocks + rows + 1);
+}
+
+}  // namespace
+
+ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch08::WorkInput& in) {
+  ch08::PreconditionerWork w = ch10::multigrid_work(part.multigrid(), in, sizeof(float), true);
+  const LaneVCycle& cycle = part.lane_v_cycle();
+  if (!cycle.lanes()) return w;
+  const LaneFineLevel& fine = cycle.fine_level();
+  const double more = fine.blocks.bytes() - float_blocks_bytes(fine);  // per pass of the level
+  const double times = ch10::smoother_products(part.multigrid());
+  PhaseWork apply;
+  apply.phase = w.apply.phase;
+  apply.working_set = w.apply.working_set + more;
+  for (PhaseWork p : w.apply.parts) {
+    if (p.phase == "level 0 smoothing and residual") {
+      p.bytes_read += times * more;
+      p.working_set += more;
+    }
+    apply.add_part(p, 1.0);
+  }
+  w.apply = apply;
+  // Every step the finest level's double blocks read once more, and the lanes written.
+  w.prepare_read += 9.0 * sizeof(double) * double(fine.blocks.blocks());
+  w.prepare_written += fine.blocks.bytes();
+  return w;
+}
+
+std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::KernelInput& in) {
+  LaneVCycle& cycle = part.lane_v_cycle();
+  if (!cycle.lanes()) return {};
+  LaneFineLevel& fine = cycle.fine_level();
+  const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
+  return {ch09::part_kernel(
+      "fine smoothing step (float, pair lanes)", "level 0 smoothing and residual",
+      fine.smoothing_work(), in.passes * ch10::smoother_products(part.multigrid()), [&fine, step] {
+        auto& v = fine.vectors;
+        ch09::for_parts(source_level(fine).rows.part, true, [&](int first, int last) {
+          smooth_rows(fine, step, first, last, v.b, &v.x, v.y);
+        });
+      })};
+}
+
+}  // namespace fem::ch14

@@ -1,0 +1,21 @@
+// This chapter's part's work (chapters/08_element_kernels/work.hpp: counted part by part):
+// chapter 12's float V-cycle, but the finest level's products read the pair lanes' layout
+// (its bytes, padding included) instead of the 3x3 float blocks, and every step fills it.
+#pragma once
+
+#include <vector>
+
+#include "chapters/08_element_kernels/work.hpp"
+#include "chapters/09_threads/work.hpp"
+#include "chapters/12_half_the_bytes/work.hpp"
+#include "chapters/14_every_lane/parts.hpp"
+
+namespace fem::ch14 {
+
+ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch08::WorkInput& in);
+
+// Its own kernel alone: the finest level's smoothing step in pair lanes (a step after the
+// first, as chapter 12's is timed).
+std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::KernelInput& in);
+
+}  // namespace fem::ch14
