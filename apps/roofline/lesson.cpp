@@ -103,7 +103,7 @@ void add_roofline_options(ArgParser& args) {
   args.option("alone-chapters", "LIST",
               "chapters whose solve's kernels run alone on the scene's mesh (ids, numbers or all; "
               "empty: none)",
-              "09,12,13");
+              "09,12,13,14");
   args.flag("no-likwid", "skip likwid-bench's check of the roofs");
   args.option("provisional", "REASON",
               "mark the data provisional (the docs check then warns instead of refusing)", "");

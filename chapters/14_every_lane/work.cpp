@@ -12,7 +12,7 @@ namespace {
 
 // The finest level's matrix as chapter 10 counts a level's (work.cpp, level_product): 3x3
 // blocks of float, an index a block and a start a row.
-double float_blocks_bytes(const LaneFineLevel& fine) {
+double float_blocks_bytes(const FineLanes& fine) {
   const double blocks = double(fine.blocks.blocks()), rows = fine.blocks.rows();
   return 9.0 * sizeof(float) * blocks + 4.0 * (blocks + rows + 1);
 }
@@ -23,7 +23,7 @@ ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch
   ch08::PreconditionerWork w = ch10::multigrid_work(part.multigrid(), in, sizeof(float), true);
   const LaneVCycle& cycle = part.lane_v_cycle();
   if (!cycle.lanes()) return w;
-  const LaneFineLevel& fine = cycle.fine_level();
+  const FineLanes& fine = cycle.fine_level();
   const double more = fine.blocks.bytes() - float_blocks_bytes(fine);  // per pass of the level
   const double times = ch10::smoother_products(part.multigrid());
   PhaseWork apply;
@@ -46,7 +46,7 @@ ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch
 std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::KernelInput& in) {
   LaneVCycle& cycle = part.lane_v_cycle();
   if (!cycle.lanes()) return {};
-  LaneFineLevel& fine = cycle.fine_level();
+  FineLanes& fine = cycle.fine_level();
   const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
   return {ch09::part_kernel(
       "fine smoothing step (float, pair lanes)", "level 0 smoothing and residual",

@@ -1,0 +1,155 @@
+// Chapter 14: the stepper whose V-cycle runs its finest level in pair lanes. Its preconditioner
+// is chapter 12's float V-cycle to float rounding (the lanes' products are the padded columns'
+// to the bit, their update rounds once where the compiler fuses: ch14_kernels.cpp), the same
+// bits on 1, 2 and 3 threads; the solve takes chapter 12's iterations; the counts the roofline
+// prices read the lanes' bytes; the stepper matches chapter 01 and allocates nothing per step.
+#include <random>
+#include <sstream>
+
+#include "catch2_compat.hpp"
+#include "chapters/09_threads/parallel.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
+#include "chapters/12_half_the_bytes/work.hpp"
+#include "chapters/14_every_lane/stepper.hpp"
+#include "chapters/14_every_lane/work.hpp"
+#include "common/threads.hpp"
+#include "support.hpp"
+
+using namespace fem;
+
+FEM_CHAPTER_TESTS("14", "[ch14]")
+
+namespace {
+
+std::vector<int> thread_counts() {
+  return openmp_enabled() ? std::vector<int>{1, 2, 3} : std::vector<int>{1};
+}
+
+// s = M r by chapter 12's float V-cycle and by the lanes' one built on the same hierarchy, for
+// random r, on the system of a few steps of chapter 12, applied inside one team as the PCG
+// applies them.
+struct Applied {
+  Eigen::VectorXd twelve, lanes;
+};
+Applied apply_both(const Scene& scene, int threads) {
+  ch12::HalfBytesStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  auto& reduced = stepper.preconditioner().v_cycle();
+  ch14::LaneVCycle lanes(reduced, stepper.preconditioner().multigrid());
+  const ThreadCountScope scope(threads);
+  const Eigen::Index n = stepper.system_rhs().size();
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd r(n);
+  for (Eigen::Index k = 0; k < n; ++k) r[k] = uniform(rng);
+  Applied out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
+  ch09::run_parallel([&] {
+    lanes.prepare(stepper.system_matrix(), ch09::RowChunks{});
+    reduced.apply(ch09::RowChunks{}, r, out.twelve);
+    lanes.apply(ch09::RowChunks{}, r, out.lanes);
+  });
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("ch14: the lanes' V-cycle is chapter 12's to float rounding, the same on 1, 2, 3 threads",
+          "[ch14]") {
+  const Scene scene = test::test_scene("cantilever");
+  const Applied first = apply_both(scene, 1);
+  REQUIRE(first.lanes.allFinite());
+  const double scale = first.twelve.cwiseAbs().maxCoeff();
+  REQUIRE(scale > 0.0);
+  // A float V-cycle's own rounding: a few float epsilons of the largest entry, times the
+  // levels' sums; the lanes differ from it only in where the update rounds.
+  const double difference = (first.lanes - first.twelve).cwiseAbs().maxCoeff();
+  INFO("largest difference " << difference << " of " << scale);
+  CHECK(difference < 1e-4 * scale);
+  for (const int threads : thread_counts()) {
+    const Applied again = apply_both(scene, threads);
+    INFO(threads << " threads");
+    CHECK((again.lanes.array() == first.lanes.array()).all());
+  }
+}
+
+TEST_CASE("ch14: chapter 12's iterations at 1e-4, at most one more, and 1e-10 still reached",
+          "[ch14]") {
+  for (const double tolerance : {1e-4, 1e-10}) {
+    for (const Scene& scene : test::equivalence_scenes()) {
+      SolverSettings settings;
+      settings.tolerance = tolerance;
+      ch12::HalfBytesStepper twelve(scene, settings);
+      ch14::EveryLaneStepper fourteen(scene, settings);
+      State a = rest_state(scene), b = a;
+      int worst = 0;
+      for (int k = 0; k < 20; ++k) {
+        twelve.step(a);
+        fourteen.step(b);
+        REQUIRE(fourteen.profile().converged);
+        worst = std::max(worst, fourteen.profile().cg_iterations - twelve.profile().cg_iterations);
+      }
+      INFO(scene.name << ", tolerance " << tolerance << ": most extra iterations " << worst);
+      CHECK(worst <= 1);
+      CHECK((b.x - a.x).cwiseAbs().maxCoeff() < 1e3 * tolerance);
+    }
+  }
+}
+
+TEST_CASE("ch14: zero heap allocations per step after the first, with 2 threads", "[ch14]") {
+  FEM_REQUIRE_ALLOCATION_COUNTER();
+  const ThreadCountScope two(openmp_enabled() ? 2 : 1);
+  for (const Scene& scene : test::equivalence_scenes()) {
+    INFO(scene.name);
+    CHECK(test::allocations_per_step("14", scene) == 0);
+  }
+}
+
+TEST_CASE("ch14: the roofline's count of the cycle reads the lanes' bytes, chapter 12's otherwise",
+          "[ch14]") {
+  const Scene scene = test::test_scene("cantilever");
+  ch12::HalfBytesStepper twelve(scene, {});
+  ch14::EveryLaneStepper fourteen(scene, {});
+  State a = rest_state(scene), b = a;
+  twelve.step(a);
+  fourteen.step(b);
+  const ch01::MeshSizes m = ch01::mesh_sizes(scene);
+  const WorkCounts counts{};
+  const ch08::WorkInput in12{m, twelve.system_matrix(), scene, counts};
+  const ch08::WorkInput in14{m, fourteen.system_matrix(), scene, counts};
+  const ch08::PreconditionerWork w12 = preconditioner_work(twelve.preconditioner(), in12);
+  const ch08::PreconditionerWork w14 = preconditioner_work(fourteen.preconditioner(), in14);
+  const auto& fine = fourteen.preconditioner().lane_v_cycle().fine_level();
+  const double products = ch10::smoother_products(fourteen.preconditioner().multigrid());
+  REQUIRE(w12.apply.parts.size() == w14.apply.parts.size());
+  for (std::size_t k = 0; k < w12.apply.parts.size(); ++k) {
+    const PhaseWork &p12 = w12.apply.parts[k], &p14 = w14.apply.parts[k];
+    INFO(p14.phase);
+    CHECK(p12.phase == p14.phase);
+    CHECK(p12.flops_float == p14.flops_float);
+    if (p14.phase != "level 0 smoothing and residual") {
+      CHECK(p12.bytes_read == p14.bytes_read);
+      continue;
+    }
+    // Per product, the bytes of one smoothing step on the lanes (LaneLevel::smoothing_work).
+    CHECK(p14.bytes_read == Approx(products * fine.smoothing_work().bytes_read).epsilon(1e-12));
+    CHECK(p14.bytes_read > p12.bytes_read);  // padding lanes and an offset a block
+  }
+  CHECK(w14.prepare_written == Approx(w12.prepare_written + fine.blocks.bytes()));
+}
+
+TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[ch14]") {
+  const Scene scene = test::test_scene("cantilever");
+  const ch14::EveryLaneStepper stepper(scene, {});
+  std::ostringstream out;
+  out << static_cast<const Stepper&>(stepper);
+  const std::string text = out.str();
+  ch14::EveryLaneStepper::for_each_part([&](const ch08::PartName& part) {
+    INFO(part.role);
+    CHECK(text.find(std::string(part.role) + ": " + part.name + " (" + std::string(part.chapter) +
+                    ")") != std::string::npos);
+  });
+  CHECK(text.find("(14_every_lane)") != std::string::npos);
+  CHECK(text.find("(12_half_the_bytes)") != std::string::npos);
+  CHECK(text.find("finest level in pair lanes") != std::string::npos);
+}
