@@ -24,6 +24,7 @@ class LaneMultigrid {
   ch09::Preconditioner& pcg_preconditioner() { return lanes_; }
   LaneVCycle& lane_v_cycle() { return lanes_; }
   const LaneVCycle& lane_v_cycle() const { return lanes_; }
+  ch12::ReducedMultigrid<float>& reduced() { return reduced_; }
   ch10::Multigrid& multigrid() { return reduced_.multigrid(); }
   const ch10::Multigrid& multigrid() const { return reduced_.multigrid(); }
   void describe(std::ostream& out) const {

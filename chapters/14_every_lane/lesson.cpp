@@ -1,0 +1,151 @@
+// Chapter 14's lesson table: `fem_lessons every-lane` (see lesson.hpp).
+#include "chapters/14_every_lane/lesson.hpp"
+
+#include <algorithm>
+#include <functional>
+#include <iomanip>
+#include <sstream>
+#include <string>
+
+#include "chapters/09_threads/parallel.hpp"
+#include "chapters/10_multigrid/v_cycle.hpp"
+#include "chapters/10_multigrid/work.hpp"
+#include "chapters/14_every_lane/stepper.hpp"
+#include "common/threads.hpp"
+
+namespace fem::ch14 {
+
+namespace {
+
+constexpr int kCalls = 100;  // calls per timing, in one parallel region as the V-cycle runs them
+
+// Microseconds per call of `call` (by every thread of the team), the median of `repeat`
+// timings of kCalls calls.
+double us_per_call(int threads, const std::function<void()>& call, int repeat) {
+  const ThreadCountScope scope(threads);
+  return 1e3 / kCalls * time_ms(repeat, [&] {
+           ch09::run_parallel([&] {
+             for (int k = 0; k < kCalls; ++k) call();
+           });
+         });
+}
+
+// The three layouts of the finest level, on this stepper's float level.
+struct Layouts {
+  FloatLevel& padded;  // chapter 12's, read by the V-cycle's generic kernels
+  LaneFineLevel& pairs;
+  RowPairFineLevel row_pairs;
+  const std::vector<int>& part;
+  int step;  // a smoothing step after the first, as the roofline times it
+};
+
+std::function<void()> smoothing(Layouts& l, int layout) {
+  auto& v = l.padded.vectors;
+  return [&l, layout, &v] {
+    ch09::for_parts(l.part, true, [&](int first, int last) {
+      if (layout == 0) ch10::smooth(l.padded, l.step, first, last, v.b, &v.x, v.y, true);
+      if (layout == 1) smooth_rows(l.pairs, l.step, first, last, v.b, &v.x, v.y);
+      if (layout == 2) smooth_rows(l.row_pairs, l.step, first, last, v.b, &v.x, v.y);
+    });
+  };
+}
+
+std::function<void()> residual(Layouts& l, int layout) {
+  auto& v = l.padded.vectors;
+  return [&l, layout, &v] {
+    ch09::for_parts(l.part, true, [&](int first, int last) {
+      if (layout == 0) ch10::residual(l.padded, first, last, v.b, v.x);
+      if (layout == 1) residual_rows(l.pairs, first, last, v.b, v.x);
+      if (layout == 2) residual_rows(l.row_pairs, first, last, v.b, v.x);
+    });
+  };
+}
+
+std::string every_lane_table(const Scene& scene, int repeat) {
+  EveryLaneStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
+  if (!cycle.lanes()) return "(" + mesh_name(scene) + ": one level, no finest level to fill)\n";
+  FloatLevel& padded = cycle.fine_level().level;
+  Layouts l{padded, cycle.fine_level(), RowPairFineLevel(padded), source_level(padded).rows.part,
+            std::min(1, ch10::smoothing_steps(padded) - 1)};
+  l.row_pairs.fill(0, l.row_pairs.blocks.rows());
+  // Bytes per call: the lanes' own count, and chapter 12's (3x3 floats and an index a block).
+  const PhaseWork lanes_step = l.pairs.smoothing_work(), lanes_residual = l.pairs.residual_work();
+  const double blocks = double(l.pairs.blocks.blocks()), rows = l.pairs.blocks.rows();
+  const double padded_more = 36.0 * blocks + 4.0 * (blocks + rows + 1) - l.pairs.blocks.bytes();
+  const int threads_max = std::min(2, max_threads());
+  std::ostringstream out;
+  out << std::fixed << "| " << mesh_name(scene) << " (" << int(rows) << " rows, " << int(blocks)
+      << " blocks), finest level, float | threads | chapter 12, us | pair lanes, us | speedup | "
+         "row pairs, us | speedup | KB per call: 12 / pair lanes | pair lanes, GB/s |\n"
+      << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+  const auto row = [&](const char* name, const PhaseWork& work, auto kernel) {
+    for (int threads = 1; threads <= threads_max; ++threads) {
+      const double old_us = us_per_call(threads, kernel(l, 0), repeat);
+      const double pair_us = us_per_call(threads, kernel(l, 1), repeat);
+      const double row_us = us_per_call(threads, kernel(l, 2), repeat);
+      out << "| " << name << " | " << threads << " | " << std::setprecision(2) << old_us << " | "
+          << pair_us << " | x" << old_us / pair_us << " | " << row_us << " | x" << old_us / row_us
+          << " | " << std::setprecision(0) << 1e-3 * (work.bytes() + padded_more) << " / "
+          << 1e-3 * work.bytes() << " | " << std::setprecision(1) << 1e-3 * work.bytes() / pair_us
+          << " |\n";
+    }
+  };
+  row("smoothing step", lanes_step, smoothing);
+  row("residual", lanes_residual, residual);
+  // The whole V-cycle, chapter 12's and this chapter's, as the PCG applies it.
+  ch12::ReducedVCycle<float>& reduced = stepper.preconditioner().reduced().v_cycle();
+  const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(padded.vectors.b.size(), -1.0, 1.0);
+  Eigen::VectorXd s(r.size());
+  for (int threads = 1; threads <= threads_max; ++threads) {
+    const double old_us = us_per_call(
+        threads, [&] { reduced.apply(ch09::RowChunks{}, r, s); }, repeat);
+    const double new_us = us_per_call(
+        threads, [&] { cycle.apply(ch09::RowChunks{}, r, s); }, repeat);
+    out << "| one V-cycle (" << ch10::smoother_products(stepper.preconditioner().multigrid())
+        << " fine products) | " << threads << " | " << std::setprecision(1) << old_us << " | "
+        << new_us << " | x" << std::setprecision(2) << old_us / new_us << " | | | | |\n";
+  }
+  const double fill_us = us_per_call(
+      1,
+      [&] {
+        ch09::for_parts(l.part, true, [&](int first, int last) { l.pairs.fill(first, last); });
+      },
+      repeat);
+  out << "\nMedians of " << repeat << " timings (--steps) of " << kCalls
+      << " calls in one parallel region, on the level of the 3rd step (the L2 or L3 cache where "
+         "it fits). Every step also fills the pair lanes from the double blocks: "
+      << std::setprecision(1) << fill_us << " us at 1 thread. " << measured_on()
+      << ". Generated by `fem_lessons every-lane`.\n";
+  return out.str();
+}
+
+void add_options(ArgParser& args) {
+  args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
+}
+
+// --steps: the timings of each kernel, their median.
+std::string tables(const LessonRun& run) {
+  const int repeat = run.steps;
+  std::string out = every_lane_table(run.scene, repeat);
+  for (const Scene& scene : more_meshes(run)) out += "\n" + every_lane_table(scene, repeat);
+  return out;
+}
+
+}  // namespace
+
+std::vector<Lesson> lessons() {
+  Lesson lesson{"every-lane",
+                "the finest level's float kernels alone: chapter 12's 4 lanes, the pair lanes, "
+                "the row pairs; one V-cycle with each",
+                "meshes/plate_poster.msh",
+                add_options,
+                tables,
+                true};
+  lesson.record_args = {"--meshes", "meshes/beam_10k.msh"};
+  return {lesson};
+}
+
+}  // namespace fem::ch14
