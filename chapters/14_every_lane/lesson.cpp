@@ -33,7 +33,7 @@ double us_per_call(int threads, const std::function<void()>& call, int repeat) {
 // The three layouts of the finest level, on this stepper's float level.
 struct Layouts {
   FloatLevel& padded;  // chapter 12's, read by the V-cycle's generic kernels
-  LaneFineLevel& pairs;
+  LaneFineLevel pairs;
   RowPairFineLevel row_pairs;
   const std::vector<int>& part;
   int step;  // a smoothing step after the first, as the roofline times it
@@ -68,8 +68,9 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
   if (!cycle.lanes()) return "(" + mesh_name(scene) + ": one level, no finest level to fill)\n";
   FloatLevel& padded = cycle.fine_level().level;
-  Layouts l{padded, cycle.fine_level(), RowPairFineLevel(padded), source_level(padded).rows.part,
+  Layouts l{padded, LaneFineLevel(padded), RowPairFineLevel(padded), source_level(padded).rows.part,
             std::min(1, ch10::smoothing_steps(padded) - 1)};
+  l.pairs.fill(0, l.pairs.blocks.rows());
   l.row_pairs.fill(0, l.row_pairs.blocks.rows());
   // Bytes per call: the lanes' own count, and chapter 12's (3x3 floats and an index a block).
   const PhaseWork lanes_step = l.pairs.smoothing_work(), lanes_residual = l.pairs.residual_work();

@@ -117,6 +117,11 @@ EXERCISES = [
      "bench": "build/release/fem_bench --chapters 12,12_NAME --steps 30 --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons batched-elements --chapter 12_NAME"},
+    {"id": "14/1", "chapter": "14", "name": "ex_rowpairs",
+     "change": [("lane_v_cycle.hpp", "using FineLanes = LaneFineLevel;", "using FineLanes = RowPairFineLevel;")],
+     "bench": "build/release/fem_bench --chapters 14,14_NAME --threads 1,2 --steps 30 --no-solvers --no-json",
+     "expect": "measured",
+     "lesson": "build/release/fem_lessons every-lane --chapter 14_NAME --steps 3"},
 ]
 
 
@@ -124,5 +129,7 @@ EXERCISES = [
 # keeps the generic tests passing); a chapter of the range with none here, or whose exercise is
 # not run, gets an unchanged variant NN_mine. And the lesson each variant's copy runs.
 STANDS_FOR = {"01": "01/2", "02": "02/1", "06": "06/2", "07": "07/2", "08": "08/1", "09": "10/5",
-              "10": "10/4", "11": "11/2", "12": "12/4"}
-LESSONS = {"07": "spmv", "08": "rotations", "09": "threads-element", "10": "multigrid"}
+              "10": "10/4", "11": "11/2", "12": "12/4",
+              "14": "14/1"}
+LESSONS = {"07": "spmv", "08": "rotations", "09": "threads-element", "10": "multigrid",
+           "14": "every-lane"}

@@ -45,3 +45,22 @@ def test_written_only_between_its_markers():
     assert "old" not in written and "`13_fewer_waits@1`" in written
     assert lessons.with_data_sections("no markers\n", data) == "no markers\n"
     assert lessons.with_data_sections(None, data) is None
+
+
+def test_a_chapter_readme_takes_the_rows_of_the_chapters_its_marker_names(tmp_path):
+    readme = tmp_path / "chapters" / "14_every_lane" / "README.md"
+    readme.parent.mkdir(parents=True)
+    name = f"{kernels_alone.MARKER}:12,14"
+    readme.write_text(f"# Chapter 14: x\n<!-- {name}:begin -->\nold\n<!-- {name}:end -->\n")
+    other = tmp_path / "chapters" / "13_fewer_waits" / "README.md"
+    other.parent.mkdir(parents=True)
+    other.write_text("# Chapter 13: y\nno marker\n")
+    data = {"kernels_alone": [run("12_half_the_bytes", 1, 1e-3, 2e-3), run("13_fewer_waits", 1, 1e-3, 2e-3),
+                              run("14_every_lane", 2, 1e-3, 2e-3)]}
+    changed = lessons.chapter_kernels_alone(tmp_path, data)
+    assert list(changed) == [readme]
+    text = changed[readme]
+    assert "old" not in text and "`12_half_the_bytes@1`" in text and "`14_every_lane@2`" in text
+    assert "`13_fewer_waits@1`" not in text
+    readme.write_text(text)
+    assert lessons.chapter_kernels_alone(tmp_path, data) == {}

@@ -12,7 +12,7 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.docs import kernels_alone
-from femtools.docs.markers import replace_between
+from femtools.docs.markers import names_in, replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
 # Sections of a lesson's page written from its data besides its table (where the page has them).
 DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: kernels_alone.section}}
@@ -33,6 +33,25 @@ def with_data_sections(text, data):
         if text is not None:
             text = replace_between(text, marker, render(data.get("data"))) or text
     return text
+
+
+def chapter_kernels_alone(root, data):
+    """The chapters' READMEs with a section `roofline-kernels-alone:NN,MM` (a chapter's kernels
+    alone beside those of the chapter it replaces), written from the roofline's data: path ->
+    new text, for those whose text it changes."""
+    changed = {}
+    for readme in sorted((root / "chapters").glob("*/README.md")):
+        text = new = readme.read_text()
+        for name in names_in(text):
+            if not name.startswith(kernels_alone.MARKER + ":"):
+                continue
+            ids = name.split(":", 1)[1].split(",")
+            runs = (data or {}).get("kernels_alone") or []
+            mine = {"kernels_alone": [r for r in runs if r["chapter"][:2] in ids]}
+            new = replace_between(new, name, kernels_alone.section(mine))
+        if new != text:
+            changed[readme] = new
+    return changed
 
 
 def main(argv=None, prog=None):
@@ -59,6 +78,15 @@ def main(argv=None, prog=None):
             else:
                 readme.write_text(new)
                 print(f"wrote the {data['marker']} table of {data['readme']} from {path.name}")
+        if data["lesson"] == "roofline":
+            for readme, new_text in chapter_kernels_alone(args.root, data.get("data")).items():
+                where = readme.relative_to(args.root)
+                if args.check:
+                    problems.append(f"{where}: its kernels-alone table is not {path.name}'s "
+                                    "(run fem-tools docs lessons)")
+                else:
+                    readme.write_text(new_text)
+                    print(f"wrote the kernels-alone table of {where} from {path.name}")
     if problems:
         print("\n".join(problems), file=sys.stderr)
         return 1
