@@ -11,7 +11,7 @@ import json
 import sys
 
 from femtools.args import command_parser, add_root_option
-from femtools.docs import kernels_alone
+from femtools.docs import kernels_alone, provenance
 from femtools.docs.markers import replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
 # Sections of a lesson's page written from its data besides its table (where the page has them).
@@ -26,13 +26,30 @@ def load(path):
     return data
 
 
-def with_data_sections(text, data):
+def with_data_sections(text, data, where=None):
     """text (None: a page without the table's markers) with the lesson's data sections written
-    where it has their markers."""
+    where it has their markers (where: the machine, compiler and commit they were recorded on)."""
     for marker, render in DATA_SECTIONS.get(data["lesson"], {}).items():
         if text is not None:
-            text = replace_between(text, marker, render(data.get("data"))) or text
+            text = replace_between(text, marker, render(data.get("data"), where)) or text
     return text
+
+
+def with_provenance(root, path, data):
+    """The lesson's table, its caption naming the machine, the compiler and the commit it was
+    recorded on (a table without a machine record, counts from Python, as it is): the commit
+    alone where the caption already names the machine and the compiler."""
+    machine = data.get("machine")
+    if not isinstance(machine, dict):
+        return data["table"], None
+    compiler, commit = provenance.lesson_build(root, path, data)
+    where = provenance.describe(machine, compiler, commit)
+    cpu = machine.get("cpu") or machine.get("model_name") or ""
+    table = data["table"].rstrip("\n")
+    named = bool(cpu) and cpu in table and bool(compiler) and compiler in table
+    table += " " if table.endswith(".") else ". "
+    return (table + (f"Recorded at commit {provenance.short_commit(commit)}.\n" if named
+                     else f"Recorded on {where}.\n"), where)
 
 
 def main(argv=None, prog=None):
@@ -49,7 +66,8 @@ def main(argv=None, prog=None):
         data = load(path)
         readme = args.root / data["readme"]
         text = readme.read_text()
-        new = with_data_sections(replace_between(text, data["marker"], data["table"]), data)
+        table, where = with_provenance(args.root, path, data)
+        new = with_data_sections(replace_between(text, data["marker"], table), data, where)
         if new is None:
             problems.append(f"{data['readme']} has no {data['marker']} markers (from {path.name})")
         elif new != text:

@@ -1,5 +1,6 @@
 """The regime sweep's generated tables (docs/data/regimes.json): its points and its solve table;
 the poster's statements are results/regimes.py's."""
+from femtools.docs import provenance
 from femtools.docs.markdown import ms, ratio, table
 from femtools.results import poster
 from femtools.results import regimes as regimes_common
@@ -47,4 +48,5 @@ def regimes_solvers_table(reg):
         f"x{regimes_common.solver_ratio(pts[-1], 'pcg_ch06'):.2f} at the stiffest"
         for body, pts in ((b, regimes_common.body_points(reg, b)) for b in reg["bodies"]))
     return (table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows) +
-            f"\nOur PCG over Eigen's `solve()` (poster x{poster.number('pcg_ch06'):g}): {ends}.\n")
+            f"\nOur PCG over Eigen's `solve()` (poster x{poster.number('pcg_ch06'):g}): {ends}. "
+            f"{provenance.of_run(reg)}.\n")

@@ -4,6 +4,7 @@ between its markers by `fem-tools docs update`."""
 import pathlib
 import re
 
+from femtools.docs import provenance
 from femtools.docs.markdown import ms, ratio, table
 from femtools.results import poster
 from femtools.results.common import BASELINE, cache_summary, chapter_dir, machine_summary
@@ -129,8 +130,8 @@ def per_node_scaling(scaling, before, this):
                 "`./tutorial.sh scaling`)\n")
     return (table(["chapter", "nodes, smallest to largest beam", "median CG iterations",
                    "median step (ms)", "solve per node (us)", "step per node (us)"], rows) +
-            f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, commit "
-            f"{scaling['commit']}. {NOTE} from docs/data/scaling.json.\n")
+            f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, "
+            f"{provenance.of_run(scaling)}. {NOTE} from docs/data/scaling.json.\n")
 
 
 def pair_scaling(scaling, before, after):
@@ -161,8 +162,8 @@ def pair_scaling(scaling, before, after):
     pair = f"{short[0]} / {short[1]}"
     return (table(["mesh", "nodes", "threads", f"step minus solve, ms: {pair} (speedup)",
                    f"solve, ms: {pair}", f"step, ms: {pair}", f"CG it.: {pair}"], rows) +
-            f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, commit "
-            f"{scaling['commit']}. {NOTE} from docs/data/scaling.json.\n")
+            f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, "
+            f"{provenance.of_run(scaling)}. {NOTE} from docs/data/scaling.json.\n")
 
 
 def viewer_table(viewer):
@@ -294,8 +295,8 @@ def chapter_table(data, name):
                       f"element pass: {ms(fused_ms(previous))} ms in `{previous['chapter']}`, "
                       f"{ms(fused_ms(c))} ms in `{c['chapter']}` ({ratio(fused_ms(previous), fused_ms(c))}).")
     return (table(header, rows) +
-            f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; machine and flags in "
-            f"[docs/results.md](../../docs/results.md).{fused_note} {NOTE}.\n")
+            f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; {provenance.of_run(data)} "
+            f"([flags](../../docs/results.md)).{fused_note}\n")
 
 
 def threads_table(threads, bench=None):
@@ -323,3 +324,29 @@ def threads_table(threads, bench=None):
                "compare the rows of one table, not milliseconds across tables."
                if bench is not None and bench.get("commit") != threads.get("commit") else "")
             + f" {NOTE}.\n")
+
+
+def fewer_waits(data, roofline):
+    """Chapter 13 against chapter 12, as measured: the step's speedup at one thread (the control:
+    no waits to save) and at two, with each row's quartiles, and the price the roofline puts on
+    the waits chapter 13 removes (docs/data/lessons/roofline.json: each run's "waiting_s", the
+    step's barriers and regions times their measured price on a spinning team)."""
+    by = chapters_by_name(data)
+    rows = {t: (by.get(f"12_half_the_bytes@{t}"), by.get(f"13_fewer_waits@{t}")) for t in (1, 2)}
+    if not all(a and b for a, b in rows.values()):
+        return "(no chapters 12 and 13 at 1 and 2 threads in docs/data/bench.json)\n"
+
+    def step(c):
+        return f"{ms(c['median_ms']['step'])} [{ms(c['q1_ms']['step'])}, {ms(c['q3_ms']['step'])}]"
+
+    lines = [f"- {t} thread{'s' if t > 1 else ''}: {ratio(a['median_ms']['step'], b['median_ms']['step'])} over "
+             f"chapter 12; steps {step(a)} and {step(b)} ms (median [quartiles], 12 and 13)"
+             for t, (a, b) in rows.items()]
+    runs = {r["chapter"]: r for r in ((roofline or {}).get("data") or {}).get("runs", [])
+            if r.get("threads") == 2 and r.get("mesh") == data["mesh"]["file"]}
+    a, b = runs.get("12_half_the_bytes"), runs.get("13_fewer_waits")
+    if a and b:
+        saved = 1e3 * (a["waiting_s"] - b["waiting_s"])
+        lines.append(f"- the waits removed, priced by the roofline at 2 threads: {saved:.3f} ms a step, "
+                     f"{100 * saved / (1e3 * a['step_s']):.1f}% of chapter 12's")
+    return "\n".join(lines) + f"\n\n{data['mesh']['file']}; {provenance.of_run(data)}.\n"
