@@ -19,9 +19,9 @@ def regimes_points_table(reg):
                          f"{100 * regimes_common.share(p, 'solve'):.0f}%", ms(p["chapters"][0]["median_ms"]["step"])] +
                         [f"x{regimes_common.speedup(p, n):.2f}" for n in names] +
                         [f"x{r:.2f}" if r else "-" for r in ratios])
-    return table(["body", "E (Pa)", "01's CG it.", "solve share of 01's step", "01's step (ms)"] +
-                 [f"`{n[:2]}`" for n in names] + ["`solveWithGuess()`", "our PCG"], rows,
-                 ["---"] + ["---:"] * (len(names) + 6))
+    return (table(["body", "E (Pa)", "01's CG it.", "solve share of 01's step", "01's step (ms)"] +
+                  [f"`{n[:2]}`" for n in names] + ["`solveWithGuess()`", "our PCG"], rows,
+                  ["---"] + ["---:"] * (len(names) + 6)) + f"\nRecorded on {provenance.of_run(reg)}.\n")
 
 
 def regimes_solvers_table(reg):
