@@ -49,7 +49,8 @@ def lesson_build(root, path, data):
     it (None where neither records one)."""
     compiler, commit = (data.get("build") or {}).get("compiler"), data.get("commit")
     book = root / MANIFEST
-    if (compiler is None or commit is None) and book.exists():
+    inside = path.resolve().is_relative_to(root.resolve())
+    if (compiler is None or commit is None) and book.exists() and inside:
         manifest = json.loads(book.read_text())
         name = path.resolve().relative_to(root.resolve()).as_posix()
         bench = "docs/data/bench.json"
