@@ -88,10 +88,13 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
   add_machine_record(machine, machine_record());
   out["machine"] = std::move(machine);
   // The build and the commit, as fem_bench records them: every timed table's caption names the
-  // machine, the compiler and the commit it was recorded on (fem-tools docs lessons).
+  // machine, the compiler and the commit it was recorded on (fem-tools docs lessons). The
+  // sources' state once per run: record-all's own JSON files, written one after another, are
+  // no change to the code it measures.
+  static const SourceState source = source_state();
   const BuildInfo b = build_info();
   out["build"] = {{"compiler", b.compiler}, {"flags", b.flags}, {"build_type", b.build_type}};
-  add_source_state(out, source_state());
+  add_source_state(out, source);
   if (!data.empty()) out["data"] = Json::parse(data);
   write_json_file(path, out);
 }

@@ -69,3 +69,10 @@ def test_chapter_13s_measured_section_from_the_committed_data():
     assert text.count("over chapter 12") == 2 and "priced by the roofline at 2 threads" in text
     assert provenance.of_run(bench) in text
     assert "no chapters 12 and 13" in tables.fewer_waits({"chapters": [], "mesh": {"file": "x"}}, None)
+
+
+def test_dirty_only_where_a_measured_source_differed():
+    assert provenance.short_commit("fa0a74e-dirty", []) == "fa0a74e"
+    assert provenance.short_commit("fa0a74e-dirty", ["chapters/13_x/stepper.hpp"]) == "fa0a74e-dirty"
+    assert provenance.short_commit("fa0a74e-dirty") == "fa0a74e-dirty"
+    assert provenance.short_commit("fa0a74e9015d") == "fa0a74e"

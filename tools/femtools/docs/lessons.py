@@ -43,12 +43,12 @@ def with_provenance(root, path, data):
     if not isinstance(machine, dict):
         return data["table"], None
     compiler, commit = provenance.lesson_build(root, path, data)
-    where = provenance.describe(machine, compiler, commit)
+    where = provenance.describe(machine, compiler, commit, data.get("uncommitted"))
     cpu = machine.get("cpu") or machine.get("model_name") or ""
     table = data["table"].rstrip("\n")
     named = bool(cpu) and cpu in table and bool(compiler) and compiler in table
     table += " " if table.endswith(".") else ". "
-    return (table + (f"Recorded at commit {provenance.short_commit(commit)}.\n" if named
+    return (table + (f"Recorded at commit {provenance.short_commit(commit, data.get('uncommitted'))}.\n" if named
                      else f"Recorded on {where}.\n"), where)
 
 

@@ -24,19 +24,25 @@ def machine_name(machine):
     return f"{cpu} ({cores} cores)" if isinstance(cores, int) and cores > 0 else cpu
 
 
-def short_commit(commit):
-    return commit[:7] + ("-dirty" if commit.endswith("-dirty") else "") if commit else NOT_RECORDED
+def short_commit(commit, uncommitted=None):
+    """The commit's first 7 digits, "-dirty" kept unless the record says that no measured source
+    differed from it (uncommitted == []: git's --dirty also sees a changed README or data file)."""
+    if not commit:
+        return NOT_RECORDED
+    dirty = commit.endswith("-dirty") and uncommitted != []
+    return commit[:7] + ("-dirty" if dirty else "")
 
 
-def describe(machine, compiler, commit):
+def describe(machine, compiler, commit, uncommitted=None):
     """ "AMD EPYC (2 cores), GNU 12.2.0, commit fa0a74e" """
     return (f"{machine_name(machine)}, {compiler or 'compiler ' + NOT_RECORDED}, "
-            f"commit {short_commit(commit)}")
+            f"commit {short_commit(commit, uncommitted)}")
 
 
 def of_run(data):
     """A benchmark run's own record (fem_bench's JSON, or the scaling and threads runs)."""
-    return describe(data.get("machine"), (data.get("build") or {}).get("compiler"), data.get("commit"))
+    return describe(data.get("machine"), (data.get("build") or {}).get("compiler"), data.get("commit"),
+                    data.get("uncommitted"))
 
 
 def _listed(root, manifest, name):
@@ -62,4 +68,4 @@ def lesson_build(root, path, data):
 
 
 def of_lesson(root, path, data):
-    return describe(data.get("machine"), *lesson_build(root, path, data))
+    return describe(data.get("machine"), *lesson_build(root, path, data), data.get("uncommitted"))
