@@ -15,6 +15,7 @@
 #include "apps/roofline/lesson.hpp"
 #include "chapters/registry.hpp"
 #include "common/atomic_file.hpp"
+#include "common/build_info.hpp"
 #include "common/cli.hpp"
 #include "common/json.hpp"
 #include "common/lesson.hpp"
@@ -86,6 +87,14 @@ void write_json(const std::string& path, const Lesson& lesson, const ChapterInfo
   Json machine = Json::object();
   add_machine_record(machine, machine_record());
   out["machine"] = std::move(machine);
+  // The build and the commit, as fem_bench records them: every timed table's caption names the
+  // machine, the compiler and the commit it was recorded on (fem-tools docs lessons). The
+  // sources' state once per run: record-all's own JSON files, written one after another, are
+  // no change to the code it measures.
+  static const SourceState source = source_state();
+  const BuildInfo b = build_info();
+  out["build"] = {{"compiler", b.compiler}, {"flags", b.flags}, {"build_type", b.build_type}};
+  add_source_state(out, source);
   if (!data.empty()) out["data"] = Json::parse(data);
   write_json_file(path, out);
 }

@@ -31,8 +31,9 @@ def larger(r):
     return "in the core" if r["in_core_s"] >= r["between_s"] else "between the kernels"
 
 
-def section(data):
-    """The Markdown between the markers, from the lesson's data (a dict, or None)."""
+def section(data, where=None):
+    """The Markdown between the markers, from the lesson's data (a dict, or None); where: the
+    machine, compiler and commit they were recorded on (femtools.docs.provenance)."""
     runs = (data or {}).get("kernels_alone")
     if not runs:
         return NOT_RECORDED
@@ -44,4 +45,5 @@ def section(data):
               "each kernel alone: of its bound"]
     larger_part = "; ".join(f"{run_name(r)} {larger(r)}" for r in runs)
     return (table(header, rows, ["---"] + ["---:"] * 6 + ["---"]) +
-            f"\nThe larger part of each solve's remainder, on this machine: {larger_part}.\n")
+            f"\nThe larger part of each solve's remainder, on this machine: {larger_part}."
+            + (f" Recorded on {where}." if where else "") + "\n")

@@ -11,7 +11,7 @@ import json
 import sys
 
 from femtools.args import command_parser, add_root_option
-from femtools.docs import kernels_alone
+from femtools.docs import kernels_alone, provenance
 from femtools.docs.markers import names_in, replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
 # Sections of a lesson's page written from its data besides its table (where the page has them).
@@ -26,16 +26,33 @@ def load(path):
     return data
 
 
-def with_data_sections(text, data):
+def with_data_sections(text, data, where=None):
     """text (None: a page without the table's markers) with the lesson's data sections written
-    where it has their markers."""
+    where it has their markers (where: the machine, compiler and commit they were recorded on)."""
     for marker, render in DATA_SECTIONS.get(data["lesson"], {}).items():
         if text is not None:
-            text = replace_between(text, marker, render(data.get("data"))) or text
+            text = replace_between(text, marker, render(data.get("data"), where)) or text
     return text
 
 
-def chapter_kernels_alone(root, data):
+def with_provenance(root, path, data):
+    """The lesson's table, its caption naming the machine, the compiler and the commit it was
+    recorded on (a table without a machine record, counts from Python, as it is): the commit
+    alone where the caption already names the machine and the compiler."""
+    machine = data.get("machine")
+    if not isinstance(machine, dict):
+        return data["table"], None
+    compiler, commit = provenance.lesson_build(root, path, data)
+    where = provenance.describe(machine, compiler, commit, data.get("uncommitted"))
+    cpu = machine.get("cpu") or machine.get("model_name") or ""
+    table = data["table"].rstrip("\n")
+    named = bool(cpu) and cpu in table and bool(compiler) and compiler in table
+    table += " " if table.endswith(".") else ". "
+    return (table + (f"Recorded at commit {provenance.short_commit(commit, data.get('uncommitted'))}.\n" if named
+                     else f"Recorded on {where}.\n"), where)
+
+
+def chapter_kernels_alone(root, data, where=None):
     """The chapters' READMEs with a section `roofline-kernels-alone:NN,MM` (a chapter's kernels
     alone beside those of the chapter it replaces), written from the roofline's data: path ->
     new text, for those whose text it changes."""
@@ -48,7 +65,7 @@ def chapter_kernels_alone(root, data):
             ids = name.split(":", 1)[1].split(",")
             runs = (data or {}).get("kernels_alone") or []
             mine = {"kernels_alone": [r for r in runs if r["chapter"][:2] in ids]}
-            new = replace_between(new, name, kernels_alone.section(mine))
+            new = replace_between(new, name, kernels_alone.section(mine, where))
         if new != text:
             changed[readme] = new
     return changed
@@ -68,7 +85,8 @@ def main(argv=None, prog=None):
         data = load(path)
         readme = args.root / data["readme"]
         text = readme.read_text()
-        new = with_data_sections(replace_between(text, data["marker"], data["table"]), data)
+        table, where = with_provenance(args.root, path, data)
+        new = with_data_sections(replace_between(text, data["marker"], table), data, where)
         if new is None:
             problems.append(f"{data['readme']} has no {data['marker']} markers (from {path.name})")
         elif new != text:
@@ -79,14 +97,14 @@ def main(argv=None, prog=None):
                 readme.write_text(new)
                 print(f"wrote the {data['marker']} table of {data['readme']} from {path.name}")
         if data["lesson"] == "roofline":
-            for readme, new_text in chapter_kernels_alone(args.root, data.get("data")).items():
-                where = readme.relative_to(args.root)
+            for page, new_text in chapter_kernels_alone(args.root, data.get("data"), where).items():
+                name = page.relative_to(args.root)
                 if args.check:
-                    problems.append(f"{where}: its kernels-alone table is not {path.name}'s "
+                    problems.append(f"{name}: its kernels-alone table is not {path.name}'s "
                                     "(run fem-tools docs lessons)")
                 else:
-                    readme.write_text(new_text)
-                    print(f"wrote the kernels-alone table of {where} from {path.name}")
+                    page.write_text(new_text)
+                    print(f"wrote the kernels-alone table of {name} from {path.name}")
     if problems:
         print("\n".join(problems), file=sys.stderr)
         return 1

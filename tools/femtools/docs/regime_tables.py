@@ -1,5 +1,6 @@
 """The regime sweep's generated tables (docs/data/regimes.json): its points and its solve table;
 the poster's statements are results/regimes.py's."""
+from femtools.docs import provenance
 from femtools.docs.markdown import ms, ratio, table
 from femtools.results import poster
 from femtools.results import regimes as regimes_common
@@ -18,9 +19,9 @@ def regimes_points_table(reg):
                          f"{100 * regimes_common.share(p, 'solve'):.0f}%", ms(p["chapters"][0]["median_ms"]["step"])] +
                         [f"x{regimes_common.speedup(p, n):.2f}" for n in names] +
                         [f"x{r:.2f}" if r else "-" for r in ratios])
-    return table(["body", "E (Pa)", "01's CG it.", "solve share of 01's step", "01's step (ms)"] +
-                 [f"`{n[:2]}`" for n in names] + ["`solveWithGuess()`", "our PCG"], rows,
-                 ["---"] + ["---:"] * (len(names) + 6))
+    return (table(["body", "E (Pa)", "01's CG it.", "solve share of 01's step", "01's step (ms)"] +
+                  [f"`{n[:2]}`" for n in names] + ["`solveWithGuess()`", "our PCG"], rows,
+                  ["---"] + ["---:"] * (len(names) + 6)) + f"\nRecorded on {provenance.of_run(reg)}.\n")
 
 
 def regimes_solvers_table(reg):
@@ -47,4 +48,5 @@ def regimes_solvers_table(reg):
         f"x{regimes_common.solver_ratio(pts[-1], 'pcg_ch06'):.2f} at the stiffest"
         for body, pts in ((b, regimes_common.body_points(reg, b)) for b in reg["bodies"]))
     return (table(["solver: median ms (vs `eigen_cg`, iterations, allocations)"] + header + ["poster"], rows) +
-            f"\nOur PCG over Eigen's `solve()` (poster x{poster.number('pcg_ch06'):g}): {ends}.\n")
+            f"\nOur PCG over Eigen's `solve()` (poster x{poster.number('pcg_ch06'):g}): {ends}. "
+            f"{provenance.of_run(reg)}.\n")

@@ -6,6 +6,8 @@ and the chapters' READMEs, wherever it stands:
                            results:solvers, headline, chapter-map, bench-table:<chapter row>
   from scaling.json        results:scaling, and in a chapter's README scaling-per-node and
                            scaling-pair (that chapter beside the course's chapter before it)
+  from bench.json and      fewer-waits (chapter 13 against 12, and the roofline's price of the
+  lessons/roofline.json    waits it removes)
   from viewer.json         viewer-fps
   from threads.json        threads-table
   from regimes.json        regimes:poster, regimes:points, regimes:solvers (results/regimes.json,
@@ -133,6 +135,8 @@ def update_all(root, loaded, stale):
         sections["viewer-fps"] = tables.viewer_table(loaded["viewer"])
     if loaded["threads"] is not None:
         sections["threads-table"] = tables.threads_table(loaded["threads"], data)
+    roofline = root / "docs" / "data" / "lessons" / "roofline.json"
+    sections["fewer-waits"] = tables.fewer_waits(data, load(roofline) if roofline.exists() else None)
     per_chapter = chapter_sections(root, scaling) if scaling is not None else {}
     for path in doc_files(root):
         update_file(path, own_sections(root, path, {**sections, **per_chapter.get(path, {})}), stale)

@@ -3,6 +3,7 @@ check, the quantities read from it (chapter 01's CG iterations and phase shares,
 chapter 01, the solve table's ratios) and the generated statements that place each of the
 poster's six numbers in the regime where it holds. Shared by runs/regimes.py, docs/update.py and
 the tests; the schema is documented in README.md beside the bench schema."""
+from femtools.docs import provenance
 from femtools.docs.markdown import table
 from femtools.results import poster
 from femtools.results.common import BASELINE
@@ -199,7 +200,8 @@ def poster_statements(data):
                    f"01's CG (`{hit[1]}`, chapter `{hit[2]}`, x{hit[3]:.3g})." if hit else
                    f"No chapter reaches the overall step's x{target:g} at any point of the sweep.") +
               f" Sweep: E from {min(e):g} to {max(e):g} Pa at dt = {data['dt']:g} s, {data['scene']}, "
-              f"{data['steps']} measured steps per point, CG tolerance {data['cg_tolerance']:g}; "
+              f"{data['steps']} measured steps per point, CG tolerance {data['cg_tolerance']:g}, "
+              f"{provenance.of_run(data)}; "
               f"x{target:g} and the rest are medians' ratios over chapter 01 (\"it.\": chapter 01's "
               "median CG iterations; \"solve\": the solve's share of chapter 01's median step).",
               "", f"Amdahl's bound: chapter 01's forces phase (rotations and element forces) takes from "
