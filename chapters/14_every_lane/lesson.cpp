@@ -61,6 +61,24 @@ std::function<void()> residual(Layouts& l, int layout) {
   };
 }
 
+// One whole V-cycle, chapter 12's and this chapter's (on the same hierarchy), as the PCG
+// applies them: a row per thread count.
+void v_cycle_rows(EveryLaneStepper& stepper, int threads_max, int repeat, std::ostream& out) {
+  LaneMultigrid& part = stepper.preconditioner();
+  ch12::ReducedVCycle<float>& reduced = part.reduced().v_cycle();
+  const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(stepper.system_rhs().size(), -1.0, 1.0);
+  Eigen::VectorXd s(r.size());
+  for (int threads = 1; threads <= threads_max; ++threads) {
+    const double old_us = us_per_call(
+        threads, [&] { reduced.apply(ch09::RowChunks{}, r, s); }, repeat);
+    const double new_us = us_per_call(
+        threads, [&] { part.lane_v_cycle().apply(ch09::RowChunks{}, r, s); }, repeat);
+    out << "| one V-cycle (" << ch10::smoother_products(part.multigrid()) << " fine products) | "
+        << threads << " | " << std::setprecision(1) << old_us << " | " << new_us << " | x"
+        << std::setprecision(2) << old_us / new_us << " | | | | |\n";
+  }
+}
+
 std::string every_lane_table(const Scene& scene, int repeat) {
   EveryLaneStepper stepper(scene, {});
   State state = rest_state(scene);
@@ -96,19 +114,7 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   };
   row("smoothing step", lanes_step, smoothing);
   row("residual", lanes_residual, residual);
-  // The whole V-cycle, chapter 12's and this chapter's, as the PCG applies it.
-  ch12::ReducedVCycle<float>& reduced = stepper.preconditioner().reduced().v_cycle();
-  const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(padded.vectors.b.size(), -1.0, 1.0);
-  Eigen::VectorXd s(r.size());
-  for (int threads = 1; threads <= threads_max; ++threads) {
-    const double old_us = us_per_call(
-        threads, [&] { reduced.apply(ch09::RowChunks{}, r, s); }, repeat);
-    const double new_us = us_per_call(
-        threads, [&] { cycle.apply(ch09::RowChunks{}, r, s); }, repeat);
-    out << "| one V-cycle (" << ch10::smoother_products(stepper.preconditioner().multigrid())
-        << " fine products) | " << threads << " | " << std::setprecision(1) << old_us << " | "
-        << new_us << " | x" << std::setprecision(2) << old_us / new_us << " | | | | |\n";
-  }
+  v_cycle_rows(stepper, threads_max, repeat, out);
   const double fill_us = us_per_call(
       1,
       [&] {
