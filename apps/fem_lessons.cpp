@@ -3,7 +3,8 @@
 // in a lesson is typed by hand). Each lesson's code lives in its chapter
 // (chapters/NN_name/lesson.cpp); this program finds it through the chapter registry, and
 // with --chapter runs a student's variant's copy beside the original's. A lesson of the whole
-// course, not of one chapter (the roofline, apps/roofline/), is registered here.
+// course, not of one chapter (the roofline, apps/roofline/; the library's frame times,
+// apps/frame_times/), is registered here.
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
@@ -11,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/frame_times/lesson.hpp"
 #include "apps/phase_owners.hpp"
 #include "apps/roofline/lesson.hpp"
 #include "chapters/registry.hpp"
@@ -39,6 +41,7 @@ std::vector<Found> course_lessons() {
     if (c.lessons && c.variant_of.empty())
       for (Lesson& l : c.lessons()) found.push_back({&c, std::move(l)});
   for (Lesson& l : roofline::lessons()) found.push_back({nullptr, std::move(l)});
+  for (Lesson& l : frame_times::lessons()) found.push_back({nullptr, std::move(l)});
   return found;
 }
 
