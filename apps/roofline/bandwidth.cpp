@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cstring>
 
 #include "apps/roofline/best_rate.hpp"
 
@@ -70,6 +71,27 @@ double write_pass(Eigen::VectorXd& a) {
   return a[0];
 }
 
+// One pass of the update kernel: each packet loaded and stored back where it was, as
+// likwid-bench's update_* kernels do; the empty asm statement takes the packet as changed, so
+// that the compiler must store it (a store of what was just loaded would be dropped).
+double update_pass(Eigen::VectorXd& a) {
+  using namespace Eigen::internal;
+  double* data = a.data();
+  for (Eigen::Index i = 0; i < a.size(); i += kStride)
+    for (int k = 0; k < kPackets; ++k) {
+      Packet packet = pload<Packet>(data + i + k * kLanes);
+#if defined(__x86_64__) || defined(__i386__)
+      asm volatile("" : "+v"(packet));
+#elif defined(__aarch64__)
+      asm volatile("" : "+w"(packet));
+#else
+      asm volatile("" : "+g"(packet));
+#endif
+      pstore(data + i + k * kLanes, packet);
+    }
+  return data[0];
+}
+
 }  // namespace
 
 std::vector<CacheLevel> cache_levels() {
@@ -123,6 +145,25 @@ double write_bandwidth(std::size_t bytes, int threads, double seconds) {
       threads, seconds, double(n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
       [](Eigen::VectorXd& a) { return write_pass(a); });
+}
+
+double update_bandwidth(std::size_t bytes, int threads, double seconds) {
+  const std::size_t n = elements(bytes);
+  return best_rate(
+      threads, seconds, 2.0 * double(n * sizeof(double)),
+      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
+      [](Eigen::VectorXd& a) { return update_pass(a); });
+}
+
+double memset_bandwidth(std::size_t bytes, int threads, double seconds) {
+  const std::size_t n = elements(bytes);
+  return best_rate(
+      threads, seconds, double(n * sizeof(double)),
+      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
+      [](Eigen::VectorXd& a) {
+        std::memset(a.data(), 0, std::size_t(a.size()) * sizeof(double));
+        return a[0];
+      });
 }
 
 double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds) {

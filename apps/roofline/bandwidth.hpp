@@ -43,6 +43,19 @@ double read_bandwidth(std::size_t bytes, int threads, double seconds);
 // line is first read (write-allocate): the roof prices that read with the store.
 double write_bandwidth(std::size_t bytes, int threads, double seconds);
 
+// The best update bandwidth (bytes read and written back per second, as likwid-bench's update
+// kernels count them): every thread loads each packet of its own array of `bytes` and stores
+// it back to the same line, which the pass has just read. The store allocates nothing: its
+// line is in the core's cache already, and leaves it written back (dirty) only.
+double update_bandwidth(std::size_t bytes, int threads, double seconds);
+
+// The best memset bandwidth (bytes zeroed per second): every thread zeroes its own array of
+// `bytes` with the C library's memset, as a chapter zeroes a matrix. glibc's memset stores
+// whole lines (rep stosb, and non-temporal stores above its threshold, a fraction of the
+// last-level cache), which need not read the line first: faster than the write kernel's
+// stores where those allocate their lines.
+double memset_bandwidth(std::size_t bytes, int threads, double seconds);
+
 // The packets the read kernel loads per stride, each kept by an empty asm statement and not
 // summed, for the lesson's text.
 int read_packets();

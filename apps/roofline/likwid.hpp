@@ -19,7 +19,10 @@ struct LikwidRate {
   std::string note;  // empty if it ran; else why not ("not installed", its error)
 };
 
-enum class LikwidKernel { load, store, peak };
+// load, store, update (a load and a store back of each element: 16 bytes an element, as our
+// update roof counts them), store_mem (non-temporal stores: what glibc's memset does above its
+// threshold) and the double multiply-add peak.
+enum class LikwidKernel { load, store, update, store_mem, peak };
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of

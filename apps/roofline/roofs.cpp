@@ -17,6 +17,8 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
     roof.level = level;
     roof.read = read_bandwidth(level.working_set, threads, seconds);
     roof.write = write_bandwidth(level.working_set, threads, seconds);
+    roof.update = update_bandwidth(level.working_set, threads, seconds);
+    roof.memset = memset_bandwidth(level.working_set, threads, seconds);
     roof.eigen_sum = eigen_sum_bandwidth(level.working_set, threads, seconds);
     // Three arrays in the same working set as the read's one.
     roof.triad = triad_bandwidth(level.working_set / 3, threads, seconds);
@@ -25,6 +27,11 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
           likwid_bench(LikwidKernel::load, level.working_set, threads, seconds, roof.read);
       roof.likwid_write =
           likwid_bench(LikwidKernel::store, level.working_set, threads, seconds, roof.write);
+      roof.likwid_update =
+          likwid_bench(LikwidKernel::update, level.working_set, threads, seconds, roof.update);
+      if (level.capacity == 0)  // memory: glibc's memset stores non-temporally at this size
+        roof.likwid_memset =
+            likwid_bench(LikwidKernel::store_mem, level.working_set, threads, seconds, roof.memset);
     }
     roofs.levels.push_back(roof);
   }
@@ -41,10 +48,12 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
   return roofs;
 }
 
+double LevelRoof::written_back_seconds() const { return std::max(0.0, 2.0 / update - 1.0 / read); }
+
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set) {
   const double per_thread = working_set / std::max(roofs.threads, 1);
   for (const LevelRoof& roof : roofs.levels)
-    if (roof.level.capacity > 0 && per_thread <= double(roof.level.capacity)) return roof;
+    if (roof.level.capacity > 0 && per_thread <= double(roof.level.working_set)) return roof;
   return roofs.levels.back();
 }
 
@@ -55,7 +64,11 @@ double memory_seconds(const Roofs& roofs, const PhaseWork& work) {
     return seconds;
   }
   const LevelRoof& level = fitting_level(roofs, work.working_set);
-  return work.bytes_read / level.read + work.bytes_written / level.write;
+  // The written bytes that are neither a memset's nor allocating: stores to lines read first.
+  const double written_back =
+      std::max(0.0, work.bytes_written - work.bytes_allocated - work.bytes_memset);
+  return work.bytes_read / level.read + work.bytes_allocated / level.write +
+         work.bytes_memset / level.memset + written_back * level.written_back_seconds();
 }
 
 std::string fitting_levels(const Roofs& roofs, const PhaseWork& work) {

@@ -13,11 +13,20 @@ namespace fem::roofline {
 
 struct LevelRoof {
   MemoryLevel level;
-  double read = 0.0;                     // bytes/s: the roof (read_bandwidth)
-  double write = 0.0;                    // bytes/s: the write roof (write_bandwidth)
-  double eigen_sum = 0.0;                // bytes/s: the second measurement (eigen_sum_bandwidth)
-  double triad = 0.0;                    // bytes/s: STREAM's triad as STREAM counts it
-  LikwidRate likwid_read, likwid_write;  // likwid-bench's load and store at the same sizes
+  double read = 0.0;       // bytes/s: the roof (read_bandwidth)
+  double write = 0.0;      // bytes/s: the write roof (write_bandwidth): stores that allocate
+  double update = 0.0;     // bytes/s read and written back (update_bandwidth)
+  double memset = 0.0;     // bytes/s zeroed by memset (memset_bandwidth)
+  double eigen_sum = 0.0;  // bytes/s: the second measurement (eigen_sum_bandwidth)
+  double triad = 0.0;      // bytes/s: STREAM's triad as STREAM counts it
+  // likwid-bench's load, store and update at the same sizes, and its non-temporal store
+  // (memory only: in a cache, glibc's memset stores as the store kernel does).
+  LikwidRate likwid_read, likwid_write, likwid_update, likwid_memset;
+
+  // Seconds a written byte costs where the pass read its line first, after the read: an update
+  // of n bytes takes 2n / update, of which n / read are its reads (0 where the update runs at
+  // twice the read roof or more: the write-back hidden under the reads).
+  double written_back_seconds() const;
 };
 
 struct Roofs {
@@ -41,18 +50,22 @@ constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
 
-// The innermost level whose share per thread holds the working set (memory if none).
+// The innermost level whose roofs were measured on as much as the working set per thread: a
+// level measured on N bytes a thread holds no more than N (the size the system reports may be
+// a virtual machine's, far above what the host gives it); memory above the largest.
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
 // The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.
 std::string fitting_levels(const Roofs& roofs, const PhaseWork& work);
 
 // The time the roofs allow a phase's bytes and flops (its bound adds its waiting, held_by):
-// its bytes read at the read roof and its bytes written at
-// the write roof of the level its working set fits (the write roof's stores allocate their
-// lines as the phase's do), or its flops at the peak (double and float flops each at their
-// own), the longer. A phase made of parts: the sum of each part's bytes at the roofs of the
-// level its own working set fits (they run one after another), or all its flops at the peak.
+// at the roofs of the level its working set fits, its bytes read at the read roof, its
+// allocating writes (bytes_allocated) at the write roof (whose stores allocate their lines as
+// those do), its memset's bytes at the memset roof, and its other written bytes, to lines it
+// read first, at written_back_seconds() each; or its flops at the peak (double and float
+// flops each at their own), the longer. A phase made of parts: the sum of each part's bytes
+// at the roofs of the level its own working set fits (they run one after another), or all its
+// flops at the peak.
 double bound_seconds(const Roofs& roofs, const PhaseWork& work);
 // Its two parts: the bytes' time and the flops' time.
 double memory_seconds(const Roofs& roofs, const PhaseWork& work);

@@ -116,6 +116,7 @@ TEST_CASE("roofline: the fused pass's writes are the objects it writes", "[roofl
   // compose zeroes A (a memset: whole lines written, none read first) and writes b afresh.
   CHECK(phase(work, "compose").bytes_written == Approx(A + b));
   CHECK(phase(work, "compose").bytes_allocated == Approx(b));
+  CHECK(phase(work, "compose").bytes_memset == Approx(A));
 }
 
 TEST_CASE("roofline: the element pass's flops are the Newton iterations it counted", "[roofline]") {
@@ -293,7 +294,7 @@ TEST_CASE("roofline: every chapter of the course counts its work through the reg
     CHECK(work.size() >= 4);
     for (const auto& w : work) {
       CHECK(w.bytes_read > 0);
-      CHECK(w.bytes_allocated <= w.bytes_written);
+      CHECK(w.bytes_allocated + w.bytes_memset <= w.bytes_written);
       CHECK(w.working_set <= w.bytes());
     }
   }
@@ -324,6 +325,8 @@ roofline::Roofs hand_roofs(int threads) {
   memory.level = {"memory", 0, 1 << 20};
   memory.read = 10e9;
   memory.write = 5e9;
+  memory.update = 8e9;
+  memory.memset = 20e9;
   roofs.levels = {memory};
   roofs.peak_double = 20e9;
   roofs.peak_float = 40e9;
@@ -372,6 +375,40 @@ TEST_CASE("roofline: each phase's waiting is its own synchronizations at their c
   REQUIRE(solve.work.phase == "solve");
   CHECK(solve.barriers >= run.iterations);  // a barrier or more per PCG iteration
   if (threads > 1) CHECK(solve.waiting_s > 0.0);
+}
+
+TEST_CASE(
+    "roofline: each written byte at the roof of its kind, each working set where its "
+    "roof was measured",
+    "[roofline]") {
+  // A cache that reports 1 MiB and was measured on 256 KiB, and memory.
+  roofline::Roofs roofs = hand_roofs(1);
+  roofline::LevelRoof cache;
+  cache.level = {"L2", 1 << 20, 256 << 10};
+  cache.read = 100e9;
+  cache.write = 50e9;
+  cache.update = 80e9;
+  cache.memset = 60e9;
+  roofs.levels.insert(roofs.levels.begin(), cache);
+  PhaseWork w;
+  w.bytes_read = 1e6;
+  w.bytes_written = 3e6;  // 1e6 allocated, 1e6 a memset's, 1e6 to lines read first
+  w.bytes_allocated = 1e6;
+  w.bytes_memset = 1e6;
+  w.working_set = 200 << 10;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L2");
+  CHECK(roofline::memory_seconds(roofs, w) ==
+        Approx(1e6 / 100e9 + 1e6 / 50e9 + 1e6 / 60e9 + 1e6 * (2 / 80e9 - 1 / 100e9)));
+  // Inside the reported 1 MiB but above the 256 KiB the roof was measured on: memory's.
+  w.working_set = 512 << 10;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "memory");
+  CHECK(roofline::memory_seconds(roofs, w) ==
+        Approx(1e6 / 10e9 + 1e6 / 5e9 + 1e6 / 20e9 + 1e6 * (2 / 8e9 - 1 / 10e9)));
+  // An update alone (each line read, then written back) runs exactly at its own roof.
+  PhaseWork update;
+  update.bytes_read = update.bytes_written = 1e6;
+  update.working_set = 1e6;
+  CHECK(roofline::memory_seconds(roofs, update) == Approx(2e6 / 8e9));
 }
 
 TEST_CASE("roofline: one thread waits for nothing, and the largest term holds a phase",
