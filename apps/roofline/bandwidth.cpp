@@ -114,11 +114,13 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
     // A shared cache holds every thread's data: each thread gets its share.
     const int sharing = std::min(std::max(threads, 1), c.shared_by);
     const std::size_t per_thread = std::size_t(c.bytes) / static_cast<std::size_t>(sharing);
-    // Half the level, but no more than four times the level inside it: the array is then out
-    // of the inner level and well inside this one, also where a virtual machine reports a
-    // last-level cache far larger than the share its host gives it.
+    // Half the level (a working set is placed in a level only up to the size its roof was
+    // measured on: fitting_level), but a shared level no more than four times the level inside
+    // it: the array is then out of the inner level and well inside this one, also where a
+    // virtual machine reports a last-level cache far larger than the share its host gives it.
+    // A core's private caches are its own, their sizes true also in a virtual machine.
     const std::size_t working_set =
-        inner > 0 ? std::min(per_thread / 2, 4 * inner) : per_thread / 2;
+        inner > 0 && c.shared_by > 1 ? std::min(per_thread / 2, 4 * inner) : per_thread / 2;
     levels.push_back({"L" + std::to_string(c.level), per_thread, working_set});
     largest = std::max(largest, std::size_t(c.bytes));
     inner = per_thread;
