@@ -2,7 +2,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <cstring>
+#include <vector>
 
 #include "apps/roofline/best_rate.hpp"
 
@@ -157,14 +157,15 @@ double update_bandwidth(std::size_t bytes, int threads, double seconds) {
       [](Eigen::VectorXd& a) { return update_pass(a); });
 }
 
-double memset_bandwidth(std::size_t bytes, int threads, double seconds) {
-  const std::size_t n = elements(bytes);
+double zero_bandwidth(std::size_t bytes, int threads, double seconds) {
+  using Blocks = std::vector<Eigen::Matrix3d>;
+  const std::size_t n = std::max<std::size_t>(1, bytes / sizeof(Eigen::Matrix3d));
   return best_rate(
-      threads, seconds, double(n * sizeof(double)),
-      [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [](Eigen::VectorXd& a) {
-        std::memset(a.data(), 0, std::size_t(a.size()) * sizeof(double));
-        return a[0];
+      threads, seconds, double(n * sizeof(Eigen::Matrix3d)),
+      [n] { return Blocks(n, Eigen::Matrix3d::Ones()); },
+      [](Blocks& blocks) {
+        for (Eigen::Matrix3d& block : blocks) block.setZero();  // compose's loop
+        return blocks[0](0, 0);
       });
 }
 

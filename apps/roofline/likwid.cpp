@@ -23,8 +23,6 @@ std::string kernel_name(LikwidKernel kernel) {
       return "store_" + isa;
     case LikwidKernel::update:
       return "update_" + isa;
-    case LikwidKernel::store_mem:
-      return "store_mem_" + isa;
     case LikwidKernel::peak:
       return "peakflops_" + isa + "_fma";
   }
@@ -76,7 +74,7 @@ std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, in
 }
 
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected) {
+                        double seconds, double expected, int runs) {
   LikwidRate r;
   r.kernel = kernel_name(kernel);
   int status = 0;
@@ -88,7 +86,7 @@ LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int t
   const bool flops = kernel == LikwidKernel::peak;
   const std::string command = likwid_command(kernel, bytes_per_thread, threads, seconds, expected);
   std::string report;
-  for (int i = 0; i < kRoofTimings; ++i) {
+  for (int i = 0; i < runs; ++i) {
     report = run(command, status);
     r.rate = std::max(r.rate, field(report, flops ? "MFlops/s" : "MByte/s") * 1e6);
   }

@@ -20,9 +20,8 @@ struct LikwidRate {
 };
 
 // load, store, update (a load and a store back of each element: 16 bytes an element, as our
-// update roof counts them), store_mem (non-temporal stores: what glibc's memset does above its
-// threshold) and the double multiply-add peak.
-enum class LikwidKernel { load, store, update, store_mem, peak };
+// update roof counts them) and the double multiply-add peak.
+enum class LikwidKernel { load, store, update, peak };
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
@@ -31,8 +30,9 @@ enum class LikwidKernel { load, store, update, store_mem, peak };
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.
+// `runs`: how many runs the best is of (kRoofTimings unless said).
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected);
+                        double seconds, double expected, int runs = kRoofTimings);
 
 // The command line of one of likwid_bench's runs (its iterations from `expected`).
 std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,

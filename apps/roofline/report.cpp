@@ -49,7 +49,8 @@ std::string syncs(double regions, double barriers) {
   return sig(regions) + " + " + sig(barriers);
 }
 
-// The bandwidth roofs of a level, in the tables' order, each with likwid-bench's check.
+// The bandwidth roofs of a level, in the tables' order, each with likwid-bench's check (none
+// for the zeroing roof).
 struct RoofKind {
   const char* name;
   double LevelRoof::*roof;
@@ -58,7 +59,7 @@ struct RoofKind {
 constexpr RoofKind kRoofKinds[] = {{"read", &LevelRoof::read, &LevelRoof::likwid_read},
                                    {"write", &LevelRoof::write, &LevelRoof::likwid_write},
                                    {"update", &LevelRoof::update, &LevelRoof::likwid_update},
-                                   {"memset", &LevelRoof::memset, &LevelRoof::likwid_memset}};
+                                   {"zeroing", &LevelRoof::zero, nullptr}};
 
 double of_bound(const PhasePoint& p) { return p.bound_s / std::max(p.measured_s, 1e-12); }
 
@@ -125,7 +126,7 @@ nlohmann::json parts_json(const Roofs& roofs, const PhaseWork& w) {
                      {"bytes_read", p.bytes_read},
                      {"bytes_written", p.bytes_written},
                      {"bytes_allocated", p.bytes_allocated},
-                     {"bytes_memset", p.bytes_memset},
+                     {"bytes_zeroed", p.bytes_zeroed},
                      {"flops", p.flops_double + p.flops_float},
                      {"working_set", p.working_set},
                      {"level", fitting_levels(roofs, p)},
@@ -144,13 +145,10 @@ std::string roofs_checked(const std::vector<Roofs>& roofs) {
       const bool l1 = &l == &r.levels.front();
       for (const RoofKind& kind : kRoofKinds) {
         const bool read = kind.roof == &LevelRoof::read;
-        const LikwidRate& likwid = l.*kind.likwid;
-        // The memset roof in a cache: glibc's memset stores as the write kernel does there,
-        // and likwid-bench's non-temporal store would go to memory.
-        const bool cached_memset = kind.roof == &LevelRoof::memset && l.level.capacity > 0;
         out << "| " << l.level.name << " " << kind.name << ", GB/s | " << r.threads << " | "
             << fixed(l.*kind.roof / 1e9, 1) << " | "
-            << (cached_memset ? "(in a cache: see the write)" : against(l.*kind.roof, likwid))
+            << (kind.likwid ? against(l.*kind.roof, l.*kind.likwid)
+                            : std::string("none of its kernels stores zeros"))
             << " | " << (l1 && read ? fixed(r.core_loads / 1e9, 1) : "") << " |\n";
       }
     }
@@ -210,7 +208,7 @@ std::string chapters_table(const std::vector<PlacedRun>& runs) {
 
 std::string phases_table(const std::vector<PlacedRun>& runs) {
   std::ostringstream out;
-  out << "| chapter | phase | MB read | MB written (+ allocated; memset) | Mflop | flop/byte | "
+  out << "| chapter | phase | MB read | MB written (+ allocated; zeroed) | Mflop | flop/byte | "
          "working set "
          "(fits) | bytes, ms | flops, ms | syncs | waiting, ms | the roofs allow, ms | held by | "
          "measured, ms | of the bound | remainder, ms |\n| --- | --- | ---: | ---: | ---: | ---: "
@@ -221,7 +219,7 @@ std::string phases_table(const std::vector<PlacedRun>& runs) {
       const double ratio = of_bound(p);
       out << "| " << run_name(r) << " | " << p.work.phase << " | " << sig(p.work.bytes_read / 1e6)
           << " | " << sig(p.work.bytes_written / 1e6) << " (+ " << sig(p.work.bytes_allocated / 1e6)
-          << (p.work.bytes_memset > 0 ? "; " + sig(p.work.bytes_memset / 1e6) : std::string())
+          << (p.work.bytes_zeroed > 0 ? "; " + sig(p.work.bytes_zeroed / 1e6) : std::string())
           << ") | " << sig(flops / 1e6) << " | " << sig(flops / p.work.bytes()) << " | "
           << size(std::size_t(p.work.working_set)) << " (" << p.level << ") | "
           << sig(1e3 * p.memory_s) << " | " << sig(1e3 * p.arithmetic_s) << " | "
@@ -259,7 +257,7 @@ nlohmann::json phase_json(const Roofs& roofs, const PhasePoint& q) {
           {"bytes_read", q.work.bytes_read},
           {"bytes_written", q.work.bytes_written},
           {"bytes_allocated", q.work.bytes_allocated},
-          {"bytes_memset", q.work.bytes_memset},
+          {"bytes_zeroed", q.work.bytes_zeroed},
           {"flops_double", q.work.flops_double},
           {"flops_float", q.work.flops_float},
           {"working_set", q.work.working_set},
@@ -293,13 +291,12 @@ std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedR
                         {"read", l.read},
                         {"write", l.write},
                         {"update", l.update},
-                        {"memset", l.memset},
+                        {"zero", l.zero},
                         {"eigen_sum", l.eigen_sum},
                         {"triad", l.triad},
                         {"likwid_read", likwid_json(l.likwid_read)},
                         {"likwid_write", likwid_json(l.likwid_write)},
-                        {"likwid_update", likwid_json(l.likwid_update)},
-                        {"likwid_memset", likwid_json(l.likwid_memset)}});
+                        {"likwid_update", likwid_json(l.likwid_update)}});
     data["roofs"].push_back({{"threads", r.threads},
                              {"peak_double", r.peak_double},
                              {"peak_float", r.peak_float},

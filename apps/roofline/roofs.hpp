@@ -16,12 +16,12 @@ struct LevelRoof {
   double read = 0.0;       // bytes/s: the roof (read_bandwidth)
   double write = 0.0;      // bytes/s: the write roof (write_bandwidth): stores that allocate
   double update = 0.0;     // bytes/s read and written back (update_bandwidth)
-  double memset = 0.0;     // bytes/s zeroed by memset (memset_bandwidth)
+  double zero = 0.0;       // bytes/s zeroed by compose's loop (zero_bandwidth)
   double eigen_sum = 0.0;  // bytes/s: the second measurement (eigen_sum_bandwidth)
   double triad = 0.0;      // bytes/s: STREAM's triad as STREAM counts it
-  // likwid-bench's load, store and update at the same sizes, and its non-temporal store
-  // (memory only: in a cache, glibc's memset stores as the store kernel does).
-  LikwidRate likwid_read, likwid_write, likwid_update, likwid_memset;
+  // likwid-bench's load, store and update at the same sizes (none of its kernels stores
+  // zeros: the zeroing roof has no check of its own).
+  LikwidRate likwid_read, likwid_write, likwid_update;
 
   // Seconds a written byte costs where the pass read its line first, after the read: an update
   // of n bytes takes 2n / update, of which n / read are its reads (0 where the update runs at
@@ -46,7 +46,9 @@ struct Roofs {
 constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
 
 // Every roof at `threads` threads, each kernel run for about `seconds`, with likwid-bench's
-// at the same sizes where `likwid` (and where it is installed).
+// at the same sizes where `likwid` (and where it is installed). The bandwidth roofs and their
+// checks take turns in kRoofRounds rounds, the best of each kept.
+constexpr int kRoofRounds = 3;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
 
@@ -61,7 +63,7 @@ std::string fitting_levels(const Roofs& roofs, const PhaseWork& work);
 // The time the roofs allow a phase's bytes and flops (its bound adds its waiting, held_by):
 // at the roofs of the level its working set fits, its bytes read at the read roof, its
 // allocating writes (bytes_allocated) at the write roof (whose stores allocate their lines as
-// those do), its memset's bytes at the memset roof, and its other written bytes, to lines it
+// those do), its zeroed bytes at the zeroing roof, and its other written bytes, to lines it
 // read first, at written_back_seconds() each; or its flops at the peak (double and float
 // flops each at their own), the longer. A phase made of parts: the sum of each part's bytes
 // at the roofs of the level its own working set fits (they run one after another), or all its

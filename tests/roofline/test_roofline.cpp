@@ -113,10 +113,10 @@ TEST_CASE("roofline: the fused pass's writes are the objects it writes", "[roofl
   const double b = double(s.system_rhs().size()) * sizeof(double);
   CHECK(phase(work, "forces").bytes_written == Approx(rotations + A + b));
   CHECK(phase(work, "forces").bytes_allocated == 0.0);  // each line read before it is written
-  // compose zeroes A (a memset: whole lines written, none read first) and writes b afresh.
+  // compose zeroes A (at the zeroing roof) and writes b afresh.
   CHECK(phase(work, "compose").bytes_written == Approx(A + b));
   CHECK(phase(work, "compose").bytes_allocated == Approx(b));
-  CHECK(phase(work, "compose").bytes_memset == Approx(A));
+  CHECK(phase(work, "compose").bytes_zeroed == Approx(A));
 }
 
 TEST_CASE("roofline: the element pass's flops are the Newton iterations it counted", "[roofline]") {
@@ -294,7 +294,7 @@ TEST_CASE("roofline: every chapter of the course counts its work through the reg
     CHECK(work.size() >= 4);
     for (const auto& w : work) {
       CHECK(w.bytes_read > 0);
-      CHECK(w.bytes_allocated + w.bytes_memset <= w.bytes_written);
+      CHECK(w.bytes_allocated + w.bytes_zeroed <= w.bytes_written);
       CHECK(w.working_set <= w.bytes());
     }
   }
@@ -335,7 +335,7 @@ roofline::Roofs hand_roofs(int threads) {
   memory.read = 10e9;
   memory.write = 5e9;
   memory.update = 8e9;
-  memory.memset = 20e9;
+  memory.zero = 20e9;
   roofs.levels = {memory};
   roofs.peak_double = 20e9;
   roofs.peak_float = 40e9;
@@ -397,13 +397,13 @@ TEST_CASE(
   cache.read = 100e9;
   cache.write = 50e9;
   cache.update = 80e9;
-  cache.memset = 60e9;
+  cache.zero = 60e9;
   roofs.levels.insert(roofs.levels.begin(), cache);
   PhaseWork w;
   w.bytes_read = 1e6;
-  w.bytes_written = 3e6;  // 1e6 allocated, 1e6 a memset's, 1e6 to lines read first
+  w.bytes_written = 3e6;  // 1e6 allocated, 1e6 zeroed, 1e6 to lines read first
   w.bytes_allocated = 1e6;
-  w.bytes_memset = 1e6;
+  w.bytes_zeroed = 1e6;
   w.working_set = 200 << 10;
   CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L2");
   CHECK(roofline::memory_seconds(roofs, w) ==

@@ -74,15 +74,15 @@ def check_with_waiting(base, folder):
 
 def current(record):
     """The record with the fields fem_lessons roofline writes now, where the committed data
-    predate them (issue 56: each level's update and memset roofs, each phase's memset bytes):
+    predate them (issue 56: each level's update and zeroing roofs, each phase's zeroed bytes):
     the placeholders change no bound, since the bounds are the record's own."""
     for roof in record["data"]["roofs"]:
         for level in roof["levels"]:
             level.setdefault("update", 2 * level["read"])
-            level.setdefault("memset", level["write"])
+            level.setdefault("zero", level["write"])
     for r in record["data"]["runs"]:
         for p in r["phases"]:
-            p.setdefault("bytes_memset", 0.0)
+            p.setdefault("bytes_zeroed", 0.0)
     return record
 
 

@@ -32,11 +32,11 @@ from femtools.args import command_parser
 from femtools.files import replacing
 from femtools.results.phases import marker, parts
 
-PHASE_FIELDS = ("phase", "bytes_read", "bytes_written", "bytes_allocated", "bytes_memset", "flops_double",
+PHASE_FIELDS = ("phase", "bytes_read", "bytes_written", "bytes_allocated", "bytes_zeroed", "flops_double",
                 "flops_float", "working_set", "level", "bound_s", "memory_s", "arithmetic_s", "measured_s")
 # The roofs each level must have: a phase's written bytes are priced at the write roof (allocating
-# stores), the update roof (stores to lines the pass read first) or the memset roof (a memset's).
-LEVEL_ROOFS = ("read", "write", "update", "memset")
+# stores), the update roof (stores to lines the pass read first) or the zeroing roof (A's blocks zeroed).
+LEVEL_ROOFS = ("read", "write", "update", "zero")
 # Each phase's own synchronizations, their waiting and which of the three holds it: in data that
 # say how the bound combines them (data["bound"]).
 WAITING_FIELDS = ("regions", "barriers", "waiting_s", "held_by")
