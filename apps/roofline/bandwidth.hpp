@@ -28,10 +28,10 @@ struct MemoryLevel {
 };
 
 // The levels with the working set each measurement uses: half of a private cache (so that
-// the code and the stack do not push the array out), half of a shared cache split between
-// `threads`, at most four times the share of the level inside it, and memory at four times
-// the largest cache. A working set is placed in a level only up to the size its roofs were
-// measured on (fitting_level, roofs.hpp).
+// the code and the stack do not push the array out) but at most eight times the level inside
+// it, half of a shared cache split between `threads` but at most four times the share of the
+// level inside it, and memory at four times the largest cache. A working set is placed in a level
+// only up to the size its roofs were measured on (fitting_level, roofs.hpp).
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads);
 
 // The best read bandwidth (bytes/s) of `threads` threads, each loading its own array of
