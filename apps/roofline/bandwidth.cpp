@@ -124,7 +124,7 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
     const std::size_t times_inner = c.shared_by > 1 ? 4 : 8;
     const std::size_t working_set =
         inner > 0 ? std::min(per_thread / 2, times_inner * inner) : per_thread / 2;
-    levels.push_back({"L" + std::to_string(c.level), per_thread, working_set});
+    levels.push_back({"L" + std::to_string(c.level), per_thread, working_set, c.shared_by > 1});
     largest = std::max(largest, std::size_t(c.bytes));
     inner = per_thread;
   }

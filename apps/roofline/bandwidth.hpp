@@ -25,6 +25,13 @@ struct MemoryLevel {
   std::string name;             // "L1", ..., "memory"
   std::size_t capacity = 0;     // bytes one thread may use and still fit (0: memory, unbounded)
   std::size_t working_set = 0;  // the array each thread reads to measure it
+  bool shared = false;          // a cache shared by cores (its reported size may be a VM's)
+
+  // The most bytes a thread's working set may have and be placed here: a private cache's
+  // capacity (its size is the core's own, true also in a virtual machine), a shared cache's
+  // measured working set (a VM may report its host's whole last-level cache: on one, 480 MiB
+  // held 184-209 MiB working sets at a roof measured on 8 MiB a thread).
+  std::size_t holds() const { return shared ? working_set : capacity; }
 };
 
 // The levels with the working set each measurement uses: half of a private cache (so that

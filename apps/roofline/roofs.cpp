@@ -58,7 +58,7 @@ double LevelRoof::written_back_seconds() const { return std::max(0.0, 2.0 / upda
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set) {
   const double per_thread = working_set / std::max(roofs.threads, 1);
   for (const LevelRoof& roof : roofs.levels)
-    if (roof.level.capacity > 0 && per_thread <= double(roof.level.working_set)) return roof;
+    if (roof.level.capacity > 0 && per_thread <= double(roof.level.holds())) return roof;
   return roofs.levels.back();
 }
 

@@ -52,9 +52,12 @@ constexpr int kRoofRounds = 3;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
 
-// The innermost level whose roofs were measured on as much as the working set per thread: a
+// The innermost level that holds the working set per thread (MemoryLevel::holds): a shared
 // level measured on N bytes a thread holds no more than N (the size the system reports may be
-// a virtual machine's, far above what the host gives it); memory above the largest.
+// a virtual machine's, far above what the host gives it), a private one its capacity (a bound
+// that charged a core's own cache at an outer level's roof would be no bound: chapter 11's
+// compose at two threads, 0.9 MiB a thread in a 1 MiB L2 measured on 384 KiB, ran at 107% of
+// the L3 roofs); memory above the largest.
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
 // The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.

@@ -321,6 +321,9 @@ TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roo
   const std::vector<CacheLevel> vm = {
       {1, "Data", 48 << 10, 1}, {2, "Unified", 2 << 20, 1}, {3, "Unified", 480 << 20, 2}};
   CHECK(roofline::memory_levels(vm, 2)[2].working_set == std::size_t(8 << 20));
+  // ... which holds no more than that; its private L2 all of itself.
+  CHECK(roofline::memory_levels(vm, 2)[2].holds() == std::size_t(8 << 20));
+  CHECK(roofline::memory_levels(vm, 2)[1].holds() == std::size_t(2 << 20));
 }
 
 namespace {
@@ -390,10 +393,10 @@ TEST_CASE(
     "roofline: each written byte at the roof of its kind, each working set where its "
     "roof was measured",
     "[roofline]") {
-  // A cache that reports 1 MiB and was measured on 256 KiB, and memory.
+  // A shared cache that reports 1 MiB and was measured on 256 KiB, and memory.
   roofline::Roofs roofs = hand_roofs(1);
   roofline::LevelRoof cache;
-  cache.level = {"L2", 1 << 20, 256 << 10};
+  cache.level = {"L3", 1 << 20, 256 << 10, true};
   cache.read = 100e9;
   cache.write = 50e9;
   cache.update = 80e9;
@@ -405,12 +408,16 @@ TEST_CASE(
   w.bytes_allocated = 1e6;
   w.bytes_zeroed = 1e6;
   w.working_set = 200 << 10;
-  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L2");
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L3");
   CHECK(roofline::memory_seconds(roofs, w) ==
         Approx(1e6 / 100e9 + 1e6 / 50e9 + 1e6 / 60e9 + 1e6 * (2 / 80e9 - 1 / 100e9)));
   // Inside the reported 1 MiB but above the 256 KiB the roof was measured on: memory's.
   w.working_set = 512 << 10;
   CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "memory");
+  // A private cache holds what it reports.
+  roofs.levels.front().level.shared = false;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L3");
+  roofs.levels.front().level.shared = true;
   CHECK(roofline::memory_seconds(roofs, w) ==
         Approx(1e6 / 10e9 + 1e6 / 5e9 + 1e6 / 20e9 + 1e6 * (2 / 8e9 - 1 / 10e9)));
   // An update alone (each line read, then written back) runs exactly at its own roof.
