@@ -25,12 +25,12 @@ enum class LikwidKernel { load, store, update, peak };
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of
-// kRoofTimings runs of about a fifth of `seconds` each. A run's length is set by its
+// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of `runs`
+// runs of about a fifth of `seconds` each (measure_roofs: two in each of its rounds, taking
+// turns with ours). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.
-// `runs`: how many runs the best is of (kRoofTimings unless said).
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
                         double seconds, double expected, int runs = kRoofTimings);
 
