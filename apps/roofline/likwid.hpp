@@ -27,7 +27,7 @@ enum class LikwidKernel { load, store, update, peak };
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
 // `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of `runs`
 // runs of about a fifth of `seconds` each (measure_roofs: two in each of its rounds, taking
-// turns with ours). A run's length is set by its
+// turns with ours, each a fifth of the roof's whole time). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.
