@@ -9,7 +9,9 @@
 //  - bytes read and bytes written: every array a phase reads or writes, once per pass over it
 //    (the compulsory traffic of the chapter's algorithm on its data structures). A write to a
 //    line the pass did not read first costs that line's read too (write-allocate): the count
-//    says so where it adds it.
+//    says so where it adds it. A write to a line the pass read first costs less (the line is
+//    in the core already: its write-back only), and zeroing a matrix block by block has a roof
+//    of its own: the count says which written bytes are zeroed.
 //  - flops: the arithmetic the phase executes, a multiply or an add each (a multiply-add is
 //    2), with the iterations it ran (CG, the rotations' Newton) as counted during the steps.
 //  - working set: the distinct bytes one pass touches; the level of the cache hierarchy that
@@ -36,6 +38,9 @@ struct PhaseWork {
   double bytes_written = 0.0;    // arrays written
   double bytes_allocated = 0.0;  // of those, written to lines the pass did not read first:
                                  // the store reads each such line before it writes it
+  double bytes_zeroed = 0.0;     // of those written, zeroed block by block (A's blocks'
+                                 // setZero; not in bytes_allocated). The rest of the written
+                                 // bytes go to lines the pass read first.
   double flops_double = 0.0;
   double flops_float = 0.0;  // float arithmetic, priced at the float peak
   double working_set = 0.0;  // bytes one pass over the phase's data touches
@@ -57,11 +62,13 @@ struct PhaseWork {
     run.bytes_read *= times;
     run.bytes_written *= times;
     run.bytes_allocated *= times;
+    run.bytes_zeroed *= times;
     run.flops_double *= times;
     run.flops_float *= times;
     bytes_read += run.bytes_read;
     bytes_written += run.bytes_written;
     bytes_allocated += run.bytes_allocated;
+    bytes_zeroed += run.bytes_zeroed;
     flops_double += run.flops_double;
     flops_float += run.flops_float;
     parts.push_back(std::move(run));

@@ -5,13 +5,68 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
+#endif
 
 namespace fem::roofline {
 
 constexpr int kRoofTimings = 5;
 
+// The CPUs this process may run on, in order (Linux; empty elsewhere).
+inline std::vector<int> allowed_cpus() {
+  std::vector<int> cpus;
+#if defined(__linux__)
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof set, &set) == 0)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) cpus.push_back(c);
+#endif
+  return cpus;
+}
+
+// The calling thread on one CPU while it lives, as likwid-bench pins each of its threads
+// (likwid-pin): no thread of a team migrates onto another's core, or away from the cache its
+// data are in, during a timing. Its own affinity back afterwards, since the OpenMP runtime
+// keeps its threads for the chapters, which do not pin. A CPU < 0: not pinned.
+class PinnedThread {
+ public:
+  explicit PinnedThread(int cpu) {
+#if defined(__linux__)
+    if (cpu < 0 || pthread_getaffinity_np(pthread_self(), sizeof saved_, &saved_) != 0) return;
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    pinned_ = pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
+#else
+    (void)cpu;
+#endif
+  }
+  ~PinnedThread() {
+#if defined(__linux__)
+    if (pinned_) pthread_setaffinity_np(pthread_self(), sizeof saved_, &saved_);
+#endif
+  }
+  PinnedThread(const PinnedThread&) = delete;
+  PinnedThread& operator=(const PinnedThread&) = delete;
+
+ private:
+#if defined(__linux__)
+  cpu_set_t saved_;
+#endif
+  bool pinned_ = false;
+};
+
 // The best rate of a kernel run by `threads` threads at once, each on its own data made by
-// make() inside the team (so that the first touch places it by its thread). One timing is
+// make() inside the team (so that the first touch places it by its thread), thread k pinned
+// to the k-th CPU the process may use (PinnedThread) from before make() to the end. One timing is
 // the team's: from the barrier that starts every thread to the barrier after the last one
 // ends, `inner` calls per thread in between (doubled until a timing lasts long enough to
 // trust the clock); the rate is the units of all threads over that wall time, so that a
@@ -29,8 +84,15 @@ double best_rate(int threads, double seconds, double units, Make make, Run run) 
   int inner = 1, timed = 0;
   bool stop = false;
   Clock::time_point start;
+  const std::vector<int> cpus = allowed_cpus();
 #pragma omp parallel num_threads(threads) reduction(+ : sink)
   {
+#ifdef _OPENMP
+    const std::size_t k = std::size_t(omp_get_thread_num());
+#else
+    const std::size_t k = 0;
+#endif
+    const PinnedThread pinned(k < cpus.size() && int(cpus.size()) >= threads ? cpus[k] : -1);
     auto state = make();
     while (true) {
 #pragma omp barrier

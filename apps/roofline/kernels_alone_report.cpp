@@ -78,6 +78,7 @@ std::string with_kernels_alone(const std::string& data, const std::vector<AloneR
                          {"bytes_read", k.work.bytes_read},
                          {"bytes_written", k.work.bytes_written},
                          {"bytes_allocated", k.work.bytes_allocated},
+                         {"bytes_zeroed", k.work.bytes_zeroed},
                          {"flops", k.work.flops_double + k.work.flops_float},
                          {"working_set", k.work.working_set}});
     section.push_back({{"chapter", r.chapter},

@@ -49,13 +49,18 @@ std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
   out << "\nRoofs: the best of repeated timings of each kernel, every thread on its own array "
       << "(read: packet loads, " << read_packets()
       << " a stride, each kept by an empty asm statement and not summed, as likwid-bench's; "
-      << "write: packet stores; "
+      << "write: packet stores; update: each packet loaded and stored back, a written byte of a "
+      << "line the pass read first priced at 2 / update - 1 / read; zeroing: compose's own loop "
+      << "of 3x3 blocks zeroed; "
       << "peak: " << fma_chains() << " independent chains of Eigen packet multiply-adds, "
       << double_lanes() << " doubles or " << float_lanes()
       << " floats per packet); a team timed from the barrier that starts it to the one after its "
-      << "last thread ends; working sets from the caches in /sys/devices/system/cpu. "
-      << roofs_check(roofs) << "Chapters: " << run.args.get_int("warmup") << " warm-up and "
-      << run.steps << " measured steps, medians; cantilever scene. " << measured_on() << ".\n";
+      << "last thread ends, each thread pinned to its own CPU; ours and likwid-bench's in "
+      << kRoofRounds << " rounds taking turns, the best of each; working sets from the caches "
+      << "in /sys/devices/system/cpu, a shared cache holding no more than its roofs were "
+      << "measured on. " << roofs_check(roofs) << "Chapters: " << run.args.get_int("warmup")
+      << " warm-up and " << run.steps << " measured steps, medians; cantilever scene. "
+      << measured_on() << ".\n";
   return out.str();
 }
 

@@ -21,6 +21,8 @@ std::string kernel_name(LikwidKernel kernel) {
       return "load_" + isa;
     case LikwidKernel::store:
       return "store_" + isa;
+    case LikwidKernel::update:
+      return "update_" + isa;
     case LikwidKernel::peak:
       return "peakflops_" + isa + "_fma";
   }
@@ -57,10 +59,11 @@ double field(const std::string& report, const std::string& label) {
 std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
                            double seconds, double expected) {
   const bool flops = kernel == LikwidKernel::peak;
-  // One iteration passes once over a thread's chunk: 8 bytes an element, and peakflops_*'s
-  // 30 flops an element (likwid-bench -l peakflops_avx512_fma).
-  const double per_iteration =
-      double(bytes_per_thread) * (flops ? 30.0 / 8.0 : 1.0) * std::max(threads, 1);
+  // One iteration passes once over a thread's chunk: 8 bytes an element (16 for update, which
+  // counts its load and its store), and peakflops_*'s 30 flops an element (likwid-bench -l
+  // peakflops_avx512_fma).
+  const double per_element = flops ? 30.0 / 8.0 : kernel == LikwidKernel::update ? 2.0 : 1.0;
+  const double per_iteration = double(bytes_per_thread) * per_element * std::max(threads, 1);
   const long long iterations =
       std::max(10LL, static_cast<long long>(expected * seconds / kRoofTimings / per_iteration));
   const std::size_t kb = std::max<std::size_t>(1, bytes_per_thread * threads / 1024);
@@ -71,7 +74,7 @@ std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, in
 }
 
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected) {
+                        double seconds, double expected, int runs) {
   LikwidRate r;
   r.kernel = kernel_name(kernel);
   int status = 0;
@@ -83,7 +86,7 @@ LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int t
   const bool flops = kernel == LikwidKernel::peak;
   const std::string command = likwid_command(kernel, bytes_per_thread, threads, seconds, expected);
   std::string report;
-  for (int i = 0; i < kRoofTimings; ++i) {
+  for (int i = 0; i < runs; ++i) {
     report = run(command, status);
     r.rate = std::max(r.rate, field(report, flops ? "MFlops/s" : "MByte/s") * 1e6);
   }

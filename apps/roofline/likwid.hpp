@@ -19,17 +19,20 @@ struct LikwidRate {
   std::string note;  // empty if it ran; else why not ("not installed", its error)
 };
 
-enum class LikwidKernel { load, store, peak };
+// load, store, update (a load and a store back of each element: 16 bytes an element, as our
+// update roof counts them) and the double multiply-add peak.
+enum class LikwidKernel { load, store, update, peak };
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of
-// kRoofTimings runs of about a fifth of `seconds` each. A run's length is set by its
+// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of `runs`
+// runs of about a fifth of `seconds` each (measure_roofs: two in each of its rounds, taking
+// turns with ours, each a fifth of the roof's whole time). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected);
+                        double seconds, double expected, int runs = kRoofTimings);
 
 // The command line of one of likwid_bench's runs (its iterations from `expected`).
 std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,

@@ -49,6 +49,18 @@ std::string syncs(double regions, double barriers) {
   return sig(regions) + " + " + sig(barriers);
 }
 
+// The bandwidth roofs of a level, in the tables' order, each with likwid-bench's check (none
+// for the zeroing roof).
+struct RoofKind {
+  const char* name;
+  double LevelRoof::*roof;
+  LikwidRate LevelRoof::*likwid;
+};
+constexpr RoofKind kRoofKinds[] = {{"read", &LevelRoof::read, &LevelRoof::likwid_read},
+                                   {"write", &LevelRoof::write, &LevelRoof::likwid_write},
+                                   {"update", &LevelRoof::update, &LevelRoof::likwid_update},
+                                   {"zeroing", &LevelRoof::zero, nullptr}};
+
 double of_bound(const PhasePoint& p) { return p.bound_s / std::max(p.measured_s, 1e-12); }
 
 // Which of the three the step's least time is most of: its phases' bytes at the roofs, their
@@ -72,12 +84,13 @@ std::string roofs_table(const std::vector<Roofs>& roofs) {
   for (std::size_t k = 0; k < roofs.size(); ++k) out << " ---: |";
   out << " ---: | ---: |\n";
   for (std::size_t l = 0; l < roofs.front().levels.size(); ++l) {
-    for (const bool read : {true, false}) {
-      out << "| " << roofs.front().levels[l].level.name << (read ? " read" : " write")
-          << ", GB/s | " << size(roofs.front().levels[l].level.working_set) << " |";
+    for (const RoofKind& kind : kRoofKinds) {
+      const bool read = kind.roof == &LevelRoof::read;
+      out << "| " << roofs.front().levels[l].level.name << " " << kind.name << ", GB/s | "
+          << size(roofs.front().levels[l].level.working_set) << " |";
       std::string check, triad;
       for (const Roofs& r : roofs) {
-        out << " " << fixed((read ? r.levels[l].read : r.levels[l].write) / 1e9, 1) << " |";
+        out << " " << fixed(r.levels[l].*kind.roof / 1e9, 1) << " |";
         check += (check.empty() ? "" : " / ") + fixed(r.levels[l].eigen_sum / 1e9, 1);
         triad += (triad.empty() ? "" : " / ") + fixed(r.levels[l].triad / 1e9, 1);
       }
@@ -113,6 +126,7 @@ nlohmann::json parts_json(const Roofs& roofs, const PhaseWork& w) {
                      {"bytes_read", p.bytes_read},
                      {"bytes_written", p.bytes_written},
                      {"bytes_allocated", p.bytes_allocated},
+                     {"bytes_zeroed", p.bytes_zeroed},
                      {"flops", p.flops_double + p.flops_float},
                      {"working_set", p.working_set},
                      {"level", fitting_levels(roofs, p)},
@@ -129,11 +143,14 @@ std::string roofs_checked(const std::vector<Roofs>& roofs) {
   for (const Roofs& r : roofs) {
     for (const LevelRoof& l : r.levels) {
       const bool l1 = &l == &r.levels.front();
-      out << "| " << l.level.name << " read, GB/s | " << r.threads << " | "
-          << fixed(l.read / 1e9, 1) << " | " << against(l.read, l.likwid_read) << " | "
-          << (l1 ? fixed(r.core_loads / 1e9, 1) : "") << " |\n";
-      out << "| " << l.level.name << " write, GB/s | " << r.threads << " | "
-          << fixed(l.write / 1e9, 1) << " | " << against(l.write, l.likwid_write) << " | |\n";
+      for (const RoofKind& kind : kRoofKinds) {
+        const bool read = kind.roof == &LevelRoof::read;
+        out << "| " << l.level.name << " " << kind.name << ", GB/s | " << r.threads << " | "
+            << fixed(l.*kind.roof / 1e9, 1) << " | "
+            << (kind.likwid ? against(l.*kind.roof, l.*kind.likwid)
+                            : std::string("none of its kernels stores zeros"))
+            << " | " << (l1 && read ? fixed(r.core_loads / 1e9, 1) : "") << " |\n";
+      }
     }
     out << "| one barrier, one parallel region, us | " << r.threads << " | "
         << fixed(1e6 * r.barrier_s, 2) << ", " << fixed(1e6 * r.region_s, 2) << " | | |\n";
@@ -191,7 +208,8 @@ std::string chapters_table(const std::vector<PlacedRun>& runs) {
 
 std::string phases_table(const std::vector<PlacedRun>& runs) {
   std::ostringstream out;
-  out << "| chapter | phase | MB read | MB written (+ allocated) | Mflop | flop/byte | working set "
+  out << "| chapter | phase | MB read | MB written (+ allocated; zeroed) | Mflop | flop/byte | "
+         "working set "
          "(fits) | bytes, ms | flops, ms | syncs | waiting, ms | the roofs allow, ms | held by | "
          "measured, ms | of the bound | remainder, ms |\n| --- | --- | ---: | ---: | ---: | ---: "
          "| --- | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |\n";
@@ -201,6 +219,7 @@ std::string phases_table(const std::vector<PlacedRun>& runs) {
       const double ratio = of_bound(p);
       out << "| " << run_name(r) << " | " << p.work.phase << " | " << sig(p.work.bytes_read / 1e6)
           << " | " << sig(p.work.bytes_written / 1e6) << " (+ " << sig(p.work.bytes_allocated / 1e6)
+          << (p.work.bytes_zeroed > 0 ? "; " + sig(p.work.bytes_zeroed / 1e6) : std::string())
           << ") | " << sig(flops / 1e6) << " | " << sig(flops / p.work.bytes()) << " | "
           << size(std::size_t(p.work.working_set)) << " (" << p.level << ") | "
           << sig(1e3 * p.memory_s) << " | " << sig(1e3 * p.arithmetic_s) << " | "
@@ -238,6 +257,7 @@ nlohmann::json phase_json(const Roofs& roofs, const PhasePoint& q) {
           {"bytes_read", q.work.bytes_read},
           {"bytes_written", q.work.bytes_written},
           {"bytes_allocated", q.work.bytes_allocated},
+          {"bytes_zeroed", q.work.bytes_zeroed},
           {"flops_double", q.work.flops_double},
           {"flops_float", q.work.flops_float},
           {"working_set", q.work.working_set},
@@ -270,10 +290,13 @@ std::string json_data(const std::vector<Roofs>& roofs, const std::vector<PlacedR
                         {"working_set", l.level.working_set},
                         {"read", l.read},
                         {"write", l.write},
+                        {"update", l.update},
+                        {"zero", l.zero},
                         {"eigen_sum", l.eigen_sum},
                         {"triad", l.triad},
                         {"likwid_read", likwid_json(l.likwid_read)},
-                        {"likwid_write", likwid_json(l.likwid_write)}});
+                        {"likwid_write", likwid_json(l.likwid_write)},
+                        {"likwid_update", likwid_json(l.likwid_update)}});
     data["roofs"].push_back({{"threads", r.threads},
                              {"peak_double", r.peak_double},
                              {"peak_float", r.peak_float},

@@ -13,11 +13,20 @@ namespace fem::roofline {
 
 struct LevelRoof {
   MemoryLevel level;
-  double read = 0.0;                     // bytes/s: the roof (read_bandwidth)
-  double write = 0.0;                    // bytes/s: the write roof (write_bandwidth)
-  double eigen_sum = 0.0;                // bytes/s: the second measurement (eigen_sum_bandwidth)
-  double triad = 0.0;                    // bytes/s: STREAM's triad as STREAM counts it
-  LikwidRate likwid_read, likwid_write;  // likwid-bench's load and store at the same sizes
+  double read = 0.0;       // bytes/s: the roof (read_bandwidth)
+  double write = 0.0;      // bytes/s: the write roof (write_bandwidth): stores that allocate
+  double update = 0.0;     // bytes/s read and written back (update_bandwidth)
+  double zero = 0.0;       // bytes/s zeroed by compose's loop (zero_bandwidth)
+  double eigen_sum = 0.0;  // bytes/s: the second measurement (eigen_sum_bandwidth)
+  double triad = 0.0;      // bytes/s: STREAM's triad as STREAM counts it
+  // likwid-bench's load, store and update at the same sizes (none of its kernels stores
+  // zeros: the zeroing roof has no check of its own).
+  LikwidRate likwid_read, likwid_write, likwid_update;
+
+  // Seconds a written byte costs where the pass read its line first, after the read: an update
+  // of n bytes takes 2n / update, of which n / read are its reads (0 where the update runs at
+  // twice the read roof or more: the write-back hidden under the reads).
+  double written_back_seconds() const;
 };
 
 struct Roofs {
@@ -37,22 +46,31 @@ struct Roofs {
 constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
 
 // Every roof at `threads` threads, each kernel run for about `seconds`, with likwid-bench's
-// at the same sizes where `likwid` (and where it is installed).
+// at the same sizes where `likwid` (and where it is installed). The bandwidth roofs and their
+// checks take turns in kRoofRounds rounds, the best of each kept.
+constexpr int kRoofRounds = 3;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
 
-// The innermost level whose share per thread holds the working set (memory if none).
+// The innermost level that holds the working set per thread (MemoryLevel::holds): a shared
+// level measured on N bytes a thread holds no more than N (the size the system reports may be
+// a virtual machine's, far above what the host gives it), a private one its capacity (a bound
+// that charged a core's own cache at an outer level's roof would be no bound: chapter 11's
+// compose at two threads, 0.9 MiB a thread in a 1 MiB L2 measured on 384 KiB, ran at 107% of
+// the L3 roofs); memory above the largest.
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
 // The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.
 std::string fitting_levels(const Roofs& roofs, const PhaseWork& work);
 
 // The time the roofs allow a phase's bytes and flops (its bound adds its waiting, held_by):
-// its bytes read at the read roof and its bytes written at
-// the write roof of the level its working set fits (the write roof's stores allocate their
-// lines as the phase's do), or its flops at the peak (double and float flops each at their
-// own), the longer. A phase made of parts: the sum of each part's bytes at the roofs of the
-// level its own working set fits (they run one after another), or all its flops at the peak.
+// at the roofs of the level its working set fits, its bytes read at the read roof, its
+// allocating writes (bytes_allocated) at the write roof (whose stores allocate their lines as
+// those do), its zeroed bytes at the zeroing roof, and its other written bytes, to lines it
+// read first, at written_back_seconds() each; or its flops at the peak (double and float
+// flops each at their own), the longer. A phase made of parts: the sum of each part's bytes
+// at the roofs of the level its own working set fits (they run one after another), or all its
+// flops at the peak.
 double bound_seconds(const Roofs& roofs, const PhaseWork& work);
 // Its two parts: the bytes' time and the flops' time.
 double memory_seconds(const Roofs& roofs, const PhaseWork& work);

@@ -17,13 +17,14 @@ ElementWork fused_pass_work(const WorkInput& in) {
   const ch01::MeshSizes& m = in.m;
   const double blocks = double(in.A.blocks.size()) * kBlock, v = m.vector_bytes;
   // compose: every block of A zeroed, the mass on the diagonal (the diagonal index read); b
-  // from gravity, M, v and f_ext (fresh lines). The zeroing loop is a call to memset (GCC turns
-  // it into one: objdump shows it), whose whole-line stores (rep stosb, or non-temporal stores
-  // above glibc's threshold) need not read the lines first: A's bytes are written, not
-  // allocated, so that the bound stays below what any core pays (a Zen 5 ran the plate's
-  // compose at 107% of the bound that charged them).
-  const PhaseWork compose = ch01::phase_work("compose", m.nodes * sizeof(int) + 4 * v, blocks + v,
-                                             v, 4 * m.dofs, blocks + m.nodes * sizeof(int) + 5 * v);
+  // from gravity, M, v and f_ext (fresh lines). A's bytes are zeroed, priced at the roof of
+  // the same zeroing loop (whole-line vector stores with GCC 12 at -march=native on a Zen 5,
+  // or a memset where the compiler makes one), which stores zeros faster than the write roof's
+  // stores of other values: a Zen 5 ran the 82k-node beam's compose at 105% of the bound that
+  // charged them at the write roof.
+  PhaseWork compose = ch01::phase_work("compose", m.nodes * sizeof(int) + 4 * v, blocks + v, v,
+                                       4 * m.dofs, blocks + m.nodes * sizeof(int) + 5 * v);
+  compose.bytes_zeroed = blocks;
   // The fused pass: per element its shape, its last two rotations (both written back), its
   // corners and block positions; x and v; every block of A and b read and added into.
   const double per_element = sizeof(ElementShape) + 2 * sizeof(Eigen::Quaterniond) +

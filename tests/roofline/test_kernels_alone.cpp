@@ -43,12 +43,14 @@ Stepped stepped(const std::string& id, const Scene& scene) {
   return s;
 }
 
-// Under made-up roofs: one level of 10 GB/s read and write, 100 Gflop/s.
+// Under made-up roofs: one level of 10 GB/s read, write, zeroing and written back (an update
+// of 20 GB/s read and written), 100 Gflop/s.
 Roofs made_up_roofs() {
   Roofs roofs;
   LevelRoof memory;
   memory.level = {"memory", 0, 1 << 20};
-  memory.read = memory.write = 1e10;
+  memory.read = memory.write = memory.zero = 1e10;
+  memory.update = 1e10;
   roofs.levels = {memory};
   roofs.peak_double = roofs.peak_float = 1e11;
   return roofs;

@@ -113,9 +113,10 @@ TEST_CASE("roofline: the fused pass's writes are the objects it writes", "[roofl
   const double b = double(s.system_rhs().size()) * sizeof(double);
   CHECK(phase(work, "forces").bytes_written == Approx(rotations + A + b));
   CHECK(phase(work, "forces").bytes_allocated == 0.0);  // each line read before it is written
-  // compose zeroes A (a memset: whole lines written, none read first) and writes b afresh.
+  // compose zeroes A (at the zeroing roof) and writes b afresh.
   CHECK(phase(work, "compose").bytes_written == Approx(A + b));
   CHECK(phase(work, "compose").bytes_allocated == Approx(b));
+  CHECK(phase(work, "compose").bytes_zeroed == Approx(A));
 }
 
 TEST_CASE("roofline: the element pass's flops are the Newton iterations it counted", "[roofline]") {
@@ -293,7 +294,7 @@ TEST_CASE("roofline: every chapter of the course counts its work through the reg
     CHECK(work.size() >= 4);
     for (const auto& w : work) {
       CHECK(w.bytes_read > 0);
-      CHECK(w.bytes_allocated <= w.bytes_written);
+      CHECK(w.bytes_allocated + w.bytes_zeroed <= w.bytes_written);
       CHECK(w.working_set <= w.bytes());
     }
   }
@@ -310,7 +311,19 @@ TEST_CASE("roofline: the roofs' working sets fit the levels they measure", "[roo
     // The shared L3 is split between the threads; memory is four times the largest cache.
     CHECK(levels[2].capacity == std::size_t(32 << 20) / threads);
     CHECK(levels.back().working_set * threads >= std::size_t(4) * (32 << 20));
+    // The private levels measured on half of themselves but at most eight times the level
+    // inside; the shared one on at most four times the level inside it.
+    CHECK(levels[0].working_set == std::size_t(24 << 10));
+    CHECK(levels[1].working_set == std::size_t(384 << 10));
+    CHECK(levels[2].working_set == std::size_t(4 << 20));
   }
+  // A virtual machine that reports a 480 MiB L3 beside 2 MiB of L2: measured on 8 MiB a thread.
+  const std::vector<CacheLevel> vm = {
+      {1, "Data", 48 << 10, 1}, {2, "Unified", 2 << 20, 1}, {3, "Unified", 480 << 20, 2}};
+  CHECK(roofline::memory_levels(vm, 2)[2].working_set == std::size_t(8 << 20));
+  // ... which holds no more than that; its private L2 all of itself.
+  CHECK(roofline::memory_levels(vm, 2)[2].holds() == std::size_t(8 << 20));
+  CHECK(roofline::memory_levels(vm, 2)[1].holds() == std::size_t(2 << 20));
 }
 
 namespace {
@@ -324,6 +337,8 @@ roofline::Roofs hand_roofs(int threads) {
   memory.level = {"memory", 0, 1 << 20};
   memory.read = 10e9;
   memory.write = 5e9;
+  memory.update = 8e9;
+  memory.zero = 20e9;
   roofs.levels = {memory};
   roofs.peak_double = 20e9;
   roofs.peak_float = 40e9;
@@ -372,6 +387,44 @@ TEST_CASE("roofline: each phase's waiting is its own synchronizations at their c
   REQUIRE(solve.work.phase == "solve");
   CHECK(solve.barriers >= run.iterations);  // a barrier or more per PCG iteration
   if (threads > 1) CHECK(solve.waiting_s > 0.0);
+}
+
+TEST_CASE(
+    "roofline: each written byte at the roof of its kind, each working set where its "
+    "roof was measured",
+    "[roofline]") {
+  // A shared cache that reports 1 MiB and was measured on 256 KiB, and memory.
+  roofline::Roofs roofs = hand_roofs(1);
+  roofline::LevelRoof cache;
+  cache.level = {"L3", 1 << 20, 256 << 10, true};
+  cache.read = 100e9;
+  cache.write = 50e9;
+  cache.update = 80e9;
+  cache.zero = 60e9;
+  roofs.levels.insert(roofs.levels.begin(), cache);
+  PhaseWork w;
+  w.bytes_read = 1e6;
+  w.bytes_written = 3e6;  // 1e6 allocated, 1e6 zeroed, 1e6 to lines read first
+  w.bytes_allocated = 1e6;
+  w.bytes_zeroed = 1e6;
+  w.working_set = 200 << 10;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L3");
+  CHECK(roofline::memory_seconds(roofs, w) ==
+        Approx(1e6 / 100e9 + 1e6 / 50e9 + 1e6 / 60e9 + 1e6 * (2 / 80e9 - 1 / 100e9)));
+  // Inside the reported 1 MiB but above the 256 KiB the roof was measured on: memory's.
+  w.working_set = 512 << 10;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "memory");
+  // A private cache holds what it reports.
+  roofs.levels.front().level.shared = false;
+  CHECK(roofline::fitting_level(roofs, w.working_set).level.name == "L3");
+  roofs.levels.front().level.shared = true;
+  CHECK(roofline::memory_seconds(roofs, w) ==
+        Approx(1e6 / 10e9 + 1e6 / 5e9 + 1e6 / 20e9 + 1e6 * (2 / 8e9 - 1 / 10e9)));
+  // An update alone (each line read, then written back) runs exactly at its own roof.
+  PhaseWork update;
+  update.bytes_read = update.bytes_written = 1e6;
+  update.working_set = 1e6;
+  CHECK(roofline::memory_seconds(roofs, update) == Approx(2e6 / 8e9));
 }
 
 TEST_CASE("roofline: one thread waits for nothing, and the largest term holds a phase",

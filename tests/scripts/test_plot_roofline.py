@@ -72,8 +72,22 @@ def check_with_waiting(base, folder):
         check(f"a phase {name} is refused", out.returncode == 1 and expect in out.stderr, out.stderr)
 
 
+def current(record):
+    """The record with the fields fem_lessons roofline writes now, where the committed data
+    predate them (issue 56: each level's update and zeroing roofs, each phase's zeroed bytes):
+    the placeholders change no bound, since the bounds are the record's own."""
+    for roof in record["data"]["roofs"]:
+        for level in roof["levels"]:
+            level.setdefault("update", 2 * level["read"])
+            level.setdefault("zero", level["write"])
+    for r in record["data"]["runs"]:
+        for p in r["phases"]:
+            p.setdefault("bytes_zeroed", 0.0)
+    return record
+
+
 def main():
-    base = json.loads(DATA.read_text())
+    base = current(json.loads(DATA.read_text()))
     base["data"].pop("provisional", None)
     for r in base["data"]["runs"]:  # every phase at twice its bound
         for p in r["phases"]:
