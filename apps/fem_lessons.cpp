@@ -157,6 +157,9 @@ int run_lesson(const Found& found, int argc, char** argv) {
   if (found.lesson.add_options) found.lesson.add_options(args);
   return run_program(program, [&] {
     if (!args.parse(argc, argv)) return 0;
+    // The program's thread count again after the lesson: record-all runs the next lesson
+    // with its own --threads or none (chapter 10's is recorded with --threads 1).
+    const ThreadCountScope program_threads(max_threads());
     threads_from_args(args);
     check_chapter_lists(args);
     const Scene scene = scene_from_args(args);
