@@ -274,6 +274,7 @@ inline void check_drift_at_default_tolerance(const std::string& chapter) {
 #include <random>
 
 #include "common/model.hpp"
+#include "common/threads.hpp"
 
 namespace fem::test {
 
@@ -328,6 +329,31 @@ std::string soak_under_mouse(Stepper& stepper, JumpingMouse& mouse, State& state
     each(k);
   }
   return "";
+}
+
+// A soak of a threaded chapter's stepper S: `steps` steps from rest under the jumping mouse (a
+// new node every 7 steps) on `threads` threads, its adaptive team off so that it really runs
+// on that many; what the soak tests assert of it.
+struct Soak {
+  State state;
+  int not_converged = 0;
+  std::string diverged;
+  double max_speed_early = 0.0, max_speed = 0.0;  // over the first 300 steps, and over all
+};
+template <class S>
+Soak soak_run(const Scene& scene, int threads, int steps) {
+  const ThreadCountScope scope(threads);
+  S stepper(scene, {});
+  stepper.team().adaptive_team().set_enabled(false);
+  JumpingMouse mouse(scene, 7);
+  Soak out;
+  out.state = rest_state(scene);
+  out.diverged = soak_under_mouse(stepper, mouse, out.state, steps, [&](int k) {
+    out.not_converged += stepper.profile().converged ? 0 : 1;
+    out.max_speed = std::max(out.max_speed, out.state.v.cwiseAbs().maxCoeff());
+    if (k < 300) out.max_speed_early = out.max_speed;
+  });
+  return out;
 }
 
 }  // namespace fem::test

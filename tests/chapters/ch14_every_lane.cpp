@@ -157,42 +157,16 @@ TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[
   CHECK(text.find("finest level in pair lanes") != std::string::npos);
 }
 
-namespace {
-
-struct Soak {
-  State state;
-  int not_converged = 0;
-  std::string diverged;
-  double max_speed_early = 0.0, max_speed = 0.0;
-};
-
-// A long run under the jumping mouse spring (support.hpp), a new node every 7 steps.
-Soak soak(const Scene& scene, int threads, int steps) {
-  const ThreadCountScope scope(threads);
-  ch14::EveryLaneStepper stepper(scene, {});
-  stepper.team().adaptive_team().set_enabled(false);
-  test::JumpingMouse mouse(scene, 7);
-  Soak out;
-  out.state = rest_state(scene);
-  out.diverged = test::soak_under_mouse(stepper, mouse, out.state, steps, [&](int k) {
-    out.not_converged += stepper.profile().converged ? 0 : 1;
-    out.max_speed = std::max(out.max_speed, out.state.v.cwiseAbs().maxCoeff());
-    if (k < 300) out.max_speed_early = out.max_speed;
-  });
-  return out;
-}
-
-}  // namespace
-
 TEST_CASE("ch14: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
           "[ch14][soak]") {
   // Every solve converges, no step diverges, the motion stays bounded (damping takes out what
   // the spring puts in), and the two thread counts give the same bits.
   const Scene scene = test::test_scene("cantilever");
   const int steps = test::soak_steps(2000);
-  const Soak one = soak(scene, 1, steps);
-  const Soak two = soak(scene, openmp_enabled() ? 2 : 1, steps);
-  for (const Soak* run : {&one, &two}) {
+  const test::Soak one = test::soak_run<ch14::EveryLaneStepper>(scene, 1, steps);
+  const test::Soak two =
+      test::soak_run<ch14::EveryLaneStepper>(scene, openmp_enabled() ? 2 : 1, steps);
+  for (const test::Soak* run : {&one, &two}) {
     CHECK(run->diverged.empty());
     CHECK(run->not_converged == 0);
     CHECK(run->max_speed_early > 0.0);
