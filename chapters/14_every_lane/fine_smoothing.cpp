@@ -8,6 +8,7 @@ namespace fem::ch14 {
 // float hierarchy's).
 static_assert(ch10::check_level_kernels<LaneFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
 static_assert(ch10::check_level_kernels<RowPairFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
+static_assert(ch10::check_level_kernels<PackedFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
 
 namespace {
 
@@ -128,6 +129,10 @@ void residual_rows(LaneLevel<Blocks>& level, int first, int last, const Eigen::V
 
 template void smooth_rows(LaneFineLevel&, int, int, int, const Eigen::VectorXf&,
                           const Eigen::VectorXf*, Eigen::VectorXf&);
+template void smooth_rows(PackedFineLevel&, int, int, int, const Eigen::VectorXf&,
+                          const Eigen::VectorXf*, Eigen::VectorXf&);
+template void residual_rows(PackedFineLevel&, int, int, const Eigen::VectorXf&,
+                            const Eigen::VectorXf&);
 template void smooth_rows(RowPairFineLevel&, int, int, int, const Eigen::VectorXf&,
                           const Eigen::VectorXf*, Eigen::VectorXf&);
 template void residual_rows(LaneFineLevel&, int, int, const Eigen::VectorXf&,
@@ -182,5 +187,6 @@ PhaseWork LaneLevel<Blocks>::residual_work() const {
 
 template struct LaneLevel<PaddedFloatBlocks>;
 template struct LaneLevel<RowPairBlocks>;
+template struct LaneLevel<PackedFloatBlocks>;
 
 }  // namespace fem::ch14

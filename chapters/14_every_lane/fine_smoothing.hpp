@@ -33,6 +33,10 @@ using PaddedFloatBlocks = PairedBlocks<float, false>;
 inline PaddedFloatBlocks lanes_of(const ch10::Level<3>& level, const PaddedFloatBlocks*) {
   return PaddedFloatBlocks(level.A);
 }
+using PackedFloatBlocks = PairedBlocks<float, true>;
+inline PackedFloatBlocks lanes_of(const ch10::Level<3>& level, const PackedFloatBlocks*) {
+  return PackedFloatBlocks(level.A);
+}
 inline RowPairBlocks lanes_of(const ch10::Level<3>& level, const RowPairBlocks*) {
   return RowPairBlocks(level.A, level.rows.part);
 }
@@ -62,8 +66,9 @@ struct LaneLevel : ch10::PolynomialLevel {
   ch10::WorkVectors<float>& vectors;
   Blocks blocks;
 };
-using LaneFineLevel = LaneLevel<PaddedFloatBlocks>;  // the pair lanes, padded
-using RowPairFineLevel = LaneLevel<RowPairBlocks>;   // the row pairs
+using LaneFineLevel = LaneLevel<PaddedFloatBlocks>;    // the pair lanes, padded
+using RowPairFineLevel = LaneLevel<RowPairBlocks>;     // the row pairs
+using PackedFineLevel = LaneLevel<PackedFloatBlocks>;  // the pair lanes, packed
 
 // Step k of the polynomial smoother on rows [first, last) of whole row blocks (from zero when
 // in is null): out and the level's direction written on those rows; every row of in must be

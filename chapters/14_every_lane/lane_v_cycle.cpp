@@ -5,11 +5,23 @@
 
 namespace fem::ch14 {
 
-LaneVCycle::LaneVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& multigrid)
+namespace {
+
+std::variant<InCacheLanes, FromMemoryLanes> fine_lanes(ch12::ReducedLevel<float, 3>& level,
+                                                       long long cache_bytes) {
+  InCacheLanes padded(level);
+  if (padded.smoothing_work().working_set <= double(cache_bytes)) return padded;
+  return FromMemoryLanes(level);
+}
+
+}  // namespace
+
+LaneVCycle::LaneVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& multigrid,
+                       long long cache_bytes)
     : reduced_(reduced),
       multigrid_(multigrid),
       lanes_(multigrid.levels() > 1),
-      fine_(reduced.fine_level()),
+      fine_(fine_lanes(reduced.fine_level(), cache_bytes)),
       r_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())),
       s_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())) {}
 
@@ -17,8 +29,10 @@ void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks
   reduced_.prepare(A, chunks);
   if (!lanes_) return;
   // Each thread fills the row blocks it smooths (the same static share of the same parts).
-  ch09::for_parts(source_level(fine_).rows.part, true,
-                  [&](int first, int last) { fine_.fill(first, last); });
+  with_fine_level([](auto& fine) {
+    ch09::for_parts(source_level(fine).rows.part, true,
+                    [&](int first, int last) { fine.fill(first, last); });
+  });
 }
 
 void LaneVCycle::apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r,
@@ -27,12 +41,12 @@ void LaneVCycle::apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r,
     reduced_.apply(chunks, r, s);
     return;
   }
-  const std::vector<int>& part = source_level(fine_).rows.part;
+  const std::vector<int>& part = reduced_.fine_level().source->rows.part;
   ch09::for_parts(part, true, [&](int first, int last) {
     r_.segment(3 * first, 3 * (last - first)) =
         r.segment(3 * first, 3 * (last - first)).cast<float>();
   });
-  multigrid_.apply(fine_, reduced_.coarse_levels(), r_, s_);
+  with_fine_level([&](auto& fine) { multigrid_.apply(fine, reduced_.coarse_levels(), r_, s_); });
   ch09::for_parts(part, true, [&](int first, int last) {
     s.segment(3 * first, 3 * (last - first)) =
         s_.segment(3 * first, 3 * (last - first)).cast<double>();

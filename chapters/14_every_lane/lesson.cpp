@@ -30,11 +30,12 @@ double us_per_call(int threads, const std::function<void()>& call, int repeat) {
          });
 }
 
-// The three layouts of the finest level, on this stepper's float level.
+// The four layouts of the finest level, on this stepper's float level.
 struct Layouts {
   FloatLevel& padded;  // chapter 12's, read by the V-cycle's generic kernels
   LaneFineLevel pairs;
   RowPairFineLevel row_pairs;
+  PackedFineLevel packed;
   const std::vector<int>& part;
   int step;  // a smoothing step after the first, as the roofline times it
 };
@@ -46,6 +47,7 @@ std::function<void()> smoothing(Layouts& l, int layout) {
       if (layout == 0) ch10::smooth(l.padded, l.step, first, last, v.b, &v.x, v.y, true);
       if (layout == 1) smooth_rows(l.pairs, l.step, first, last, v.b, &v.x, v.y);
       if (layout == 2) smooth_rows(l.row_pairs, l.step, first, last, v.b, &v.x, v.y);
+      if (layout == 3) smooth_rows(l.packed, l.step, first, last, v.b, &v.x, v.y);
     });
   };
 }
@@ -57,6 +59,7 @@ std::function<void()> residual(Layouts& l, int layout) {
       if (layout == 0) ch10::residual(l.padded, first, last, v.b, v.x);
       if (layout == 1) residual_rows(l.pairs, first, last, v.b, v.x);
       if (layout == 2) residual_rows(l.row_pairs, first, last, v.b, v.x);
+      if (layout == 3) residual_rows(l.packed, first, last, v.b, v.x);
     });
   };
 }
@@ -75,7 +78,7 @@ void v_cycle_rows(EveryLaneStepper& stepper, int threads_max, int repeat, std::o
         threads, [&] { part.lane_v_cycle().apply(ch09::RowChunks{}, r, s); }, repeat);
     out << "| one V-cycle (" << ch10::smoother_products(part.multigrid()) << " fine products) | "
         << threads << " | " << std::setprecision(1) << old_us << " | " << new_us << " | x"
-        << std::setprecision(2) << old_us / new_us << " | | | | |\n";
+        << std::setprecision(2) << old_us / new_us << " | | | | | | |\n";
   }
 }
 
@@ -85,11 +88,16 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   for (int k = 0; k < 3; ++k) stepper.step(state);
   LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
   if (!cycle.lanes()) return "(" + mesh_name(scene) + ": one level, no finest level to fill)\n";
-  FloatLevel& padded = cycle.fine_level().level;
-  Layouts l{padded, LaneFineLevel(padded), RowPairFineLevel(padded), source_level(padded).rows.part,
+  FloatLevel& padded = stepper.preconditioner().reduced().v_cycle().fine_level();
+  Layouts l{padded,
+            LaneFineLevel(padded),
+            RowPairFineLevel(padded),
+            PackedFineLevel(padded),
+            source_level(padded).rows.part,
             std::min(1, ch10::smoothing_steps(padded) - 1)};
   l.pairs.fill(0, l.pairs.blocks.rows());
   l.row_pairs.fill(0, l.row_pairs.blocks.rows());
+  l.packed.fill(0, l.packed.blocks.rows());
   // Bytes per call: the lanes' own count, and chapter 12's (3x3 floats and an index a block).
   const PhaseWork lanes_step = l.pairs.smoothing_work(), lanes_residual = l.pairs.residual_work();
   const double blocks = double(l.pairs.blocks.blocks()), rows = l.pairs.blocks.rows();
@@ -98,16 +106,19 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   std::ostringstream out;
   out << std::fixed << "| " << mesh_name(scene) << " (" << int(rows) << " rows, " << int(blocks)
       << " blocks), finest level, float | threads | chapter 12, us | pair lanes, us | speedup | "
-         "row pairs, us | speedup | KB per call: 12 / pair lanes | pair lanes, GB/s |\n"
-      << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+         "packed pairs, us | speedup | row pairs, us | speedup | KB per call: 12 / pair lanes | "
+         "pair lanes, GB/s |\n"
+      << "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
   const auto row = [&](const char* name, const PhaseWork& work, auto kernel) {
     for (int threads = 1; threads <= threads_max; ++threads) {
       const double old_us = us_per_call(threads, kernel(l, 0), repeat);
       const double pair_us = us_per_call(threads, kernel(l, 1), repeat);
       const double row_us = us_per_call(threads, kernel(l, 2), repeat);
+      const double packed_us = us_per_call(threads, kernel(l, 3), repeat);
       out << "| " << name << " | " << threads << " | " << std::setprecision(2) << old_us << " | "
-          << pair_us << " | x" << old_us / pair_us << " | " << row_us << " | x" << old_us / row_us
-          << " | " << std::setprecision(0) << 1e-3 * (work.bytes() + padded_more) << " / "
+          << pair_us << " | x" << old_us / pair_us << " | " << packed_us << " | x"
+          << old_us / packed_us << " | " << row_us << " | x" << old_us / row_us << " | "
+          << std::setprecision(0) << 1e-3 * (work.bytes() + padded_more) << " / "
           << 1e-3 * work.bytes() << " | " << std::setprecision(1) << 1e-3 * work.bytes() / pair_us
           << " |\n";
     }
@@ -121,10 +132,12 @@ std::string every_lane_table(const Scene& scene, int repeat) {
         ch09::for_parts(l.part, true, [&](int first, int last) { l.pairs.fill(first, last); });
       },
       repeat);
-  out << "\nMedians of " << repeat << " timings (--steps) of " << kCalls
+  out << "\nMedians of " << repeat << " timings of " << kCalls
       << " calls in one parallel region, on the level of the 3rd step (the L2 or L3 cache where "
-         "it fits). Every step also fills the pair lanes from the double blocks: "
-      << std::setprecision(1) << fill_us << " us at 1 thread. " << measured_on()
+         "it fits, else memory). The V-cycle's lanes are the stepper's choice for this level: "
+      << (cycle.in_cache() ? "padded (it fits in the last cache)" : "packed (it does not fit)")
+      << ". Every step also fills the pair lanes from the double blocks: " << std::setprecision(1)
+      << fill_us << " us at 1 thread. " << measured_on()
       << ". Generated by `fem_lessons every-lane`.\n";
   return out.str();
 }
@@ -133,11 +146,17 @@ void add_options(ArgParser& args) {
   args.option("meshes", "LIST", "further meshes, comma-separated: a table for each", "");
 }
 
-// --steps: the timings of each kernel, their median.
+// --steps: the timings of each kernel, their median; fewer on a large mesh (at least 5), so that
+// each kernel takes about as long as on a mesh of 200,000 blocks.
+int timings(const Scene& scene, int steps) {
+  const double blocks = 3.7 * scene.mesh.num_tets();  // the block rows hold about 3.7 a tet
+  return std::clamp(int(steps * 200000.0 / blocks), std::min(5, steps), steps);
+}
+
 std::string tables(const LessonRun& run) {
-  const int repeat = run.steps;
-  std::string out = every_lane_table(run.scene, repeat);
-  for (const Scene& scene : more_meshes(run)) out += "\n" + every_lane_table(scene, repeat);
+  std::string out = every_lane_table(run.scene, timings(run.scene, run.steps));
+  for (const Scene& scene : more_meshes(run))
+    out += "\n" + every_lane_table(scene, timings(scene, run.steps));
   return out;
 }
 
@@ -152,6 +171,8 @@ std::vector<Lesson> lessons() {
                 tables,
                 true};
   lesson.record_args = {"--meshes", "meshes/beam_10k.msh"};
+  // A finest level larger than this machine's last cache (./tutorial.sh meshes --large).
+  lesson.record_meshes_if_present = {"meshes/generated/beam_50k.msh"};
   return {lesson};
 }
 

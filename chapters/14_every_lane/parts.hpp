@@ -30,7 +30,8 @@ class LaneMultigrid {
   void describe(std::ostream& out) const {
     reduced_.describe(out);
     if (lanes_.lanes())
-      out << "    finest level in pair lanes: " << lanes_.fine_level().blocks.bytes() / 1024
+      out << "    finest level in pair lanes, " << (lanes_.in_cache() ? "padded" : "packed") << ": "
+          << lanes_.with_fine_level([](const auto& fine) { return fine.blocks.bytes(); }) / 1024
           << " KiB\n";
   }
 

@@ -12,7 +12,8 @@ namespace {
 
 // The finest level's matrix as chapter 10 counts a level's (work.cpp, level_product): 3x3
 // blocks of float, an index a block and a start a row.
-double float_blocks_bytes(const FineLanes& fine) {
+template <class Fine>
+double float_blocks_bytes(const Fine& fine) {
   const double blocks = double(fine.blocks.blocks()), rows = fine.blocks.rows();
   return 9.0 * sizeof(float) * blocks + 4.0 * (blocks + rows + 1);
 }
@@ -23,8 +24,13 @@ ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch
   ch08::PreconditionerWork w = ch10::multigrid_work(part.multigrid(), in, sizeof(float), true);
   const LaneVCycle& cycle = part.lane_v_cycle();
   if (!cycle.lanes()) return w;
-  const FineLanes& fine = cycle.fine_level();
-  const double more = fine.blocks.bytes() - float_blocks_bytes(fine);  // per pass of the level
+  // Per pass of the level: the padding lanes (padded) and an offset a block (both).
+  const double more = cycle.with_fine_level(
+      [](const auto& fine) { return fine.blocks.bytes() - float_blocks_bytes(fine); });
+  const double lanes_bytes =
+      cycle.with_fine_level([](const auto& fine) { return fine.blocks.bytes(); });
+  const double blocks =
+      cycle.with_fine_level([](const auto& fine) { return double(fine.blocks.blocks()); });
   const double times = ch10::smoother_products(part.multigrid());
   PhaseWork apply;
   apply.phase = w.apply.phase;
@@ -38,24 +44,26 @@ ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch
   }
   w.apply = apply;
   // Every step the finest level's double blocks read once more, and the lanes written.
-  w.prepare_read += 9.0 * sizeof(double) * double(fine.blocks.blocks());
-  w.prepare_written += fine.blocks.bytes();
+  w.prepare_read += 9.0 * sizeof(double) * blocks;
+  w.prepare_written += lanes_bytes;
   return w;
 }
 
 std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::KernelInput& in) {
   LaneVCycle& cycle = part.lane_v_cycle();
   if (!cycle.lanes()) return {};
-  FineLanes& fine = cycle.fine_level();
-  const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
-  return {ch09::part_kernel(
-      "fine smoothing step (float, pair lanes)", "level 0 smoothing and residual",
-      fine.smoothing_work(), in.passes * ch10::smoother_products(part.multigrid()), [&fine, step] {
-        auto& v = fine.vectors;
-        ch09::for_parts(source_level(fine).rows.part, true, [&](int first, int last) {
-          smooth_rows(fine, step, first, last, v.b, &v.x, v.y);
-        });
-      })};
+  return cycle.with_fine_level([&](auto& fine) {
+    const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
+    return std::vector<PartKernel>{ch09::part_kernel(
+        "fine smoothing step (float, pair lanes)", "level 0 smoothing and residual",
+        fine.smoothing_work(), in.passes * ch10::smoother_products(part.multigrid()),
+        [&fine, step] {
+          auto& v = fine.vectors;
+          ch09::for_parts(source_level(fine).rows.part, true, [&](int first, int last) {
+            smooth_rows(fine, step, first, last, v.b, &v.x, v.y);
+          });
+        })};
+  });
 }
 
 }  // namespace fem::ch14

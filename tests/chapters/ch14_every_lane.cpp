@@ -34,12 +34,14 @@ std::vector<int> thread_counts() {
 struct Applied {
   Eigen::VectorXd twelve, lanes;
 };
-Applied apply_both(const Scene& scene, int threads) {
+// cache_bytes: the finest level's layout (huge: padded, 0: packed).
+Applied apply_both(const Scene& scene, int threads, long long cache_bytes) {
   ch12::HalfBytesStepper stepper(scene, {});
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
   auto& reduced = stepper.preconditioner().v_cycle();
-  ch14::LaneVCycle lanes(reduced, stepper.preconditioner().multigrid());
+  ch14::LaneVCycle lanes(reduced, stepper.preconditioner().multigrid(), cache_bytes);
+  REQUIRE(lanes.in_cache() == (cache_bytes > 0));
   const ThreadCountScope scope(threads);
   const Eigen::Index n = stepper.system_rhs().size();
   std::mt19937 rng(14);
@@ -57,22 +59,27 @@ Applied apply_both(const Scene& scene, int threads) {
 
 }  // namespace
 
-TEST_CASE("ch14: the lanes' V-cycle is chapter 12's to float rounding, the same on 1, 2, 3 threads",
-          "[ch14]") {
+TEST_CASE(
+    "ch14: the lanes' V-cycle, padded and packed, is chapter 12's to float rounding, the same on "
+    "1, 2, 3 threads",
+    "[ch14]") {
   const Scene scene = test::test_scene("cantilever");
-  const Applied first = apply_both(scene, 1);
-  REQUIRE(first.lanes.allFinite());
-  const double scale = first.twelve.cwiseAbs().maxCoeff();
-  REQUIRE(scale > 0.0);
-  // A float V-cycle's own rounding: a few float epsilons of the largest entry, times the
-  // levels' sums; the lanes differ from it only in where the update rounds.
-  const double difference = (first.lanes - first.twelve).cwiseAbs().maxCoeff();
-  INFO("largest difference " << difference << " of " << scale);
-  CHECK(difference < 1e-4 * scale);
-  for (const int threads : thread_counts()) {
-    const Applied again = apply_both(scene, threads);
-    INFO(threads << " threads");
-    CHECK((again.lanes.array() == first.lanes.array()).all());
+  for (const long long cache_bytes : {0LL, 1LL << 40}) {
+    INFO((cache_bytes > 0 ? "padded" : "packed"));
+    const Applied first = apply_both(scene, 1, cache_bytes);
+    REQUIRE(first.lanes.allFinite());
+    const double scale = first.twelve.cwiseAbs().maxCoeff();
+    REQUIRE(scale > 0.0);
+    // A float V-cycle's own rounding: a few float epsilons of the largest entry, times the
+    // levels' sums; the lanes differ from it only in where the update rounds.
+    const double difference = (first.lanes - first.twelve).cwiseAbs().maxCoeff();
+    INFO("largest difference " << difference << " of " << scale);
+    CHECK(difference < 1e-4 * scale);
+    for (const int threads : thread_counts()) {
+      const Applied again = apply_both(scene, threads, cache_bytes);
+      INFO(threads << " threads");
+      CHECK((again.lanes.array() == first.lanes.array()).all());
+    }
   }
 }
 
@@ -122,7 +129,11 @@ TEST_CASE("ch14: the roofline's count of the cycle reads the lanes' bytes, chapt
   const ch08::WorkInput in14{m, fourteen.system_matrix(), scene, counts};
   const ch08::PreconditionerWork w12 = preconditioner_work(twelve.preconditioner(), in12);
   const ch08::PreconditionerWork w14 = preconditioner_work(fourteen.preconditioner(), in14);
-  const auto& fine = fourteen.preconditioner().lane_v_cycle().fine_level();
+  const ch14::LaneVCycle& cycle = fourteen.preconditioner().lane_v_cycle();
+  const double lanes_step_bytes =
+      cycle.with_fine_level([](const auto& fine) { return fine.smoothing_work().bytes_read; });
+  const double lanes_bytes =
+      cycle.with_fine_level([](const auto& fine) { return fine.blocks.bytes(); });
   const double products = ch10::smoother_products(fourteen.preconditioner().multigrid());
   REQUIRE(w12.apply.parts.size() == w14.apply.parts.size());
   for (std::size_t k = 0; k < w12.apply.parts.size(); ++k) {
@@ -135,10 +146,10 @@ TEST_CASE("ch14: the roofline's count of the cycle reads the lanes' bytes, chapt
       continue;
     }
     // Per product, the bytes of one smoothing step on the lanes (LaneLevel::smoothing_work).
-    CHECK(p14.bytes_read == Approx(products * fine.smoothing_work().bytes_read).epsilon(1e-12));
+    CHECK(p14.bytes_read == Approx(products * lanes_step_bytes).epsilon(1e-12));
     CHECK(p14.bytes_read > p12.bytes_read);  // padding lanes and an offset a block
   }
-  CHECK(w14.prepare_written == Approx(w12.prepare_written + fine.blocks.bytes()));
+  CHECK(w14.prepare_written == Approx(w12.prepare_written + lanes_bytes));
 }
 
 TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[ch14]") {

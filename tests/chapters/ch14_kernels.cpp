@@ -171,6 +171,7 @@ TEST_CASE(
   for (const std::string mesh : {"plate_poster.msh", "test_beam.msh"}) {
     SECTION("pair lanes " + mesh) { check_smoothing<ch14::LaneFineLevel>(mesh); }
     SECTION("row pairs " + mesh) { check_smoothing<ch14::RowPairFineLevel>(mesh); }
+    SECTION("packed pairs " + mesh) { check_smoothing<ch14::PackedFineLevel>(mesh); }
   }
 }
 

@@ -118,7 +118,7 @@ EXERCISES = [
      "expect": "measured",
      "lesson": "build/release/fem_lessons batched-elements --chapter 12_NAME"},
     {"id": "14/1", "chapter": "14", "name": "ex_rowpairs",
-     "change": [("lane_v_cycle.hpp", "using FineLanes = LaneFineLevel;", "using FineLanes = RowPairFineLevel;")],
+     "change": [("lane_v_cycle.hpp", "using InCacheLanes = LaneFineLevel;", "using InCacheLanes = RowPairFineLevel;")],
      "bench": "build/release/fem_bench --chapters 14,14_NAME --threads 1,2 --steps 30 --no-solvers --no-json",
      "expect": "measured",
      "lesson": "build/release/fem_lessons every-lane --chapter 14_NAME --steps 3"},
