@@ -57,7 +57,8 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
 // a virtual machine's, far above what the host gives it), a private one its capacity (a bound
 // that charged a core's own cache at an outer level's roof would be no bound: chapter 11's
 // compose at two threads, 0.9 MiB a thread in a 1 MiB L2 measured on 384 KiB, ran at 107% of
-// the L3 roofs); memory above the largest.
+// the L3 roofs); memory above the largest. memory_seconds charges the share of a working set
+// that the level inside could hold at that level's roofs, the rest at this one's.
 const LevelRoof& fitting_level(const Roofs& roofs, double working_set);
 
 // The levels a phase's working set fits: its parts' ("L2+L3"), innermost first.
