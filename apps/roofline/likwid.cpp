@@ -64,8 +64,9 @@ std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, in
   // peakflops_avx512_fma).
   const double per_element = flops ? 30.0 / 8.0 : kernel == LikwidKernel::update ? 2.0 : 1.0;
   const double per_iteration = double(bytes_per_thread) * per_element * std::max(threads, 1);
+  const double run_s = std::max(seconds / kRoofTimings, kLikwidRunSeconds);
   const long long iterations =
-      std::max(10LL, static_cast<long long>(expected * seconds / kRoofTimings / per_iteration));
+      std::max(10LL, static_cast<long long>(expected * run_s / per_iteration));
   const std::size_t kb = std::max<std::size_t>(1, bytes_per_thread * threads / 1024);
   std::ostringstream command;
   command << "likwid-bench -t " << kernel_name(kernel) << " -W S0:" << kb << "kB:" << threads

@@ -23,11 +23,18 @@ struct LikwidRate {
 // update roof counts them) and the double multiply-add peak.
 enum class LikwidKernel { load, store, update, peak };
 
+// A likwid-bench run lasts at least this long: its short runs at two threads report less than
+// its threads do (on the 2-core Zen 5 VM, store_avx512 in L1 at two threads: 218-340 GB/s in
+// runs of 0.1-0.5 s, 404-498 in runs of 1.5 s, against 218-265 at one thread; a pinned,
+// barrier-timed loop of the same stores 518-545 at two), so that a check made of short runs
+// measured its own start, not the cache.
+constexpr double kLikwidRunSeconds = 1.0;
+
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), timed as our own roofs are (best_rate.hpp): the best of `runs`
-// runs of about a fifth of `seconds` each (measure_roofs: two in each of its rounds, taking
-// turns with ours, each a fifth of the roof's whole time). A run's length is set by its
+// `bytes_per_thread` (-W), the best of `runs` runs of a fifth of `seconds` each, or
+// kLikwidRunSeconds if longer (measure_roofs: two in each of its rounds, taking turns with
+// ours). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.

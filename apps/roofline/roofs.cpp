@@ -27,9 +27,9 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
       roof.update = std::max(roof.update, update_bandwidth(bytes, threads, round_s));
       roof.zero = std::max(roof.zero, zero_bandwidth(bytes, threads, round_s));
       if (!likwid) continue;
-      // likwid-bench's runs a fifth of `seconds` each, not of the round: its short runs at two
-      // threads report less (on the Zen 5 VM, update in L2: 556-668 GB/s in runs of 13 ms,
-      // 735-754 in runs of 130 ms; ours 761).
+      // likwid-bench's runs a fifth of `seconds` each (or kLikwidRunSeconds), not of the round:
+      // its short runs at two threads report less (on the Zen 5 VM, update in L2: 556-668 GB/s
+      // in runs of 13 ms, 735-754 in runs of 130 ms; ours 761).
       const auto check = [&](LikwidRate& best, LikwidKernel kernel, double expected) {
         const LikwidRate r = likwid_bench(kernel, bytes, threads, seconds, expected, 2);
         if (r.rate > best.rate || best.kernel.empty()) best = r;

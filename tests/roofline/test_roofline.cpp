@@ -444,20 +444,25 @@ TEST_CASE("roofline: one thread waits for nothing, and the largest term holds a 
   CHECK(std::string(roofline::held_by(1.0, 2.0, 3.0)) == "waiting");
 }
 
-TEST_CASE("roofline: likwid-bench runs as long as our own timings, set by its iterations",
-          "[roofline]") {
+TEST_CASE(
+    "roofline: likwid-bench runs a fifth of our roof's time or a second if longer, set by its "
+    "iterations",
+    "[roofline]") {
   // 1 MiB a thread at an expected 10 GB/s for the team of 2, 0.5 s in 5 runs: 0.1 s a run,
-  // 1 GB, 2 MiB an iteration: 476 iterations. -s would take whole seconds only ("0.5" is
-  // none, and likwid-bench then runs its least, ten iterations).
+  // raised to kLikwidRunSeconds (1 s), 10 GB, 2 MiB an iteration: 4768 iterations. -s would
+  // take whole seconds only ("0.5" is none, and likwid-bench then runs its least, ten).
   using fem::roofline::likwid_command;
   using fem::roofline::LikwidKernel;
   const std::string load = likwid_command(LikwidKernel::load, 1 << 20, 2, 0.5, 10e9);
   CHECK(load.find(" -W S0:2048kB:2 ") != std::string::npos);
-  CHECK(load.find(" -i 476 ") != std::string::npos);
+  CHECK(load.find(" -i 4768 ") != std::string::npos);
   CHECK(load.find(" -s ") == std::string::npos);
+  // 10 s in 5 runs: 2 s a run, longer than the least.
+  CHECK(likwid_command(LikwidKernel::load, 1 << 20, 2, 10.0, 10e9).find(" -i 9536 ") !=
+        std::string::npos);
   // peakflops: 30 flops an element of 8 bytes, 16 KiB a thread, 100 Gflop/s on 1 thread.
   const std::string peak = likwid_command(LikwidKernel::peak, 16 << 10, 1, 0.5, 100e9);
-  CHECK(peak.find(" -i 162760 ") != std::string::npos);
+  CHECK(peak.find(" -i 1627604 ") != std::string::npos);
   // Never fewer than likwid-bench's own least.
   CHECK(likwid_command(LikwidKernel::store, 1 << 20, 1, 0.5, 1.0).find(" -i 10 ") !=
         std::string::npos);
