@@ -356,4 +356,22 @@ Soak soak_run(const Scene& scene, int threads, int steps) {
   return out;
 }
 
+// The soak tests of a threaded chapter's stepper S: 2,000 steps (soak_steps) on 1 and 2 threads.
+// Every solve converges, no step diverges, the motion stays bounded (damping takes out what the
+// spring puts in), and the two thread counts give the same bits.
+template <class S>
+void check_soak(const Scene& scene) {
+  const int steps = soak_steps(2000);
+  const Soak one = soak_run<S>(scene, 1, steps);
+  const Soak two = soak_run<S>(scene, openmp_enabled() ? 2 : 1, steps);
+  for (const Soak* run : {&one, &two}) {
+    CHECK(run->diverged.empty());
+    CHECK(run->not_converged == 0);
+    CHECK(run->max_speed_early > 0.0);
+    CHECK(run->max_speed < 10.0 * run->max_speed_early);
+  }
+  CHECK((one.state.x.array() == two.state.x.array()).all());
+  CHECK((one.state.v.array() == two.state.v.array()).all());
+}
+
 }  // namespace fem::test

@@ -264,21 +264,7 @@ TEST_CASE("ch13: zero heap allocations per step after the first, with 2 threads"
 
 TEST_CASE("ch13: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
           "[ch13][soak]") {
-  // Every solve converges, no step diverges, the motion stays bounded (damping takes out what
-  // the spring puts in), and the two thread counts give the same bits.
-  const Scene scene = test::test_scene("cantilever");
-  const int steps = test::soak_steps(2000);
-  const test::Soak one = test::soak_run<ch13::FewerWaitsStepper>(scene, 1, steps);
-  const test::Soak two =
-      test::soak_run<ch13::FewerWaitsStepper>(scene, openmp_enabled() ? 2 : 1, steps);
-  for (const test::Soak* run : {&one, &two}) {
-    CHECK(run->diverged.empty());
-    CHECK(run->not_converged == 0);
-    CHECK(run->max_speed_early > 0.0);
-    CHECK(run->max_speed < 10.0 * run->max_speed_early);
-  }
-  CHECK(bit_identical(one.state.x, two.state.x));
-  CHECK(bit_identical(one.state.v, two.state.v));
+  test::check_soak<ch13::FewerWaitsStepper>(test::test_scene("cantilever"));
 }
 
 TEST_CASE("ch13: the iterations lesson's counts, per setting, the same on 1 and 2 threads",

@@ -170,19 +170,5 @@ TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[
 
 TEST_CASE("ch14: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
           "[ch14][soak]") {
-  // Every solve converges, no step diverges, the motion stays bounded (damping takes out what
-  // the spring puts in), and the two thread counts give the same bits.
-  const Scene scene = test::test_scene("cantilever");
-  const int steps = test::soak_steps(2000);
-  const test::Soak one = test::soak_run<ch14::EveryLaneStepper>(scene, 1, steps);
-  const test::Soak two =
-      test::soak_run<ch14::EveryLaneStepper>(scene, openmp_enabled() ? 2 : 1, steps);
-  for (const test::Soak* run : {&one, &two}) {
-    CHECK(run->diverged.empty());
-    CHECK(run->not_converged == 0);
-    CHECK(run->max_speed_early > 0.0);
-    CHECK(run->max_speed < 10.0 * run->max_speed_early);
-  }
-  CHECK((one.state.x.array() == two.state.x.array()).all());
-  CHECK((one.state.v.array() == two.state.v.array()).all());
+  test::check_soak<ch14::EveryLaneStepper>(test::test_scene("cantilever"));
 }
