@@ -55,8 +55,9 @@ std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
       << "peak: " << fma_chains() << " independent chains of Eigen packet multiply-adds, "
       << double_lanes() << " doubles or " << float_lanes()
       << " floats per packet); a team timed from the barrier that starts it to the one after its "
-      << "last thread ends, each thread pinned to its own CPU; ours and likwid-bench's in "
-      << kRoofRounds << " rounds taking turns, the best of each; working sets from the caches "
+      << "last thread ends, each thread pinned to its own CPU; each roof and its likwid-bench run "
+      << "back to back, equally long, in " << kRoofRounds
+      << " rounds, the best of each; working sets from the caches "
       << "in /sys/devices/system/cpu, a shared cache holding no more than its roofs were "
       << "measured on. " << roofs_check(roofs) << "Chapters: " << run.args.get_int("warmup")
       << " warm-up and " << run.steps << " measured steps, medians; cantilever scene. "

@@ -33,8 +33,8 @@ constexpr double kLikwidRunSeconds = 1.0;
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
 // `bytes_per_thread` (-W), the best of `runs` runs of a fifth of `seconds` each, or
-// kLikwidRunSeconds if longer (measure_roofs: two in each of its rounds, taking turns with
-// ours). A run's length is set by its
+// kLikwidRunSeconds if longer (measure_roofs: one in each of its rounds, right after our
+// roof's timing of the same length). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.

@@ -16,27 +16,30 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
     LevelRoof roof;
     roof.level = level;
     const std::size_t bytes = level.working_set;
-    // Ours and likwid-bench's take turns, kRoofRounds rounds of a third of the time each, the
-    // best of the rounds kept: a virtual machine's host moves a level's rate from one minute to
-    // the next (the 2-core Zen 5 VM's memory read at two threads: 40 to 110 GB/s), and a roof
-    // timed in one minute beside a check timed in the next compares the minutes.
-    const double round_s = seconds / kRoofRounds;
+    // Each roof and its likwid-bench check run back to back, as long as each other, in
+    // kRoofRounds rounds, the best of the rounds kept: a virtual machine's host moves a level's
+    // rate from one minute to the next (the 2-core Zen 5 VM's memory store at two threads: 30
+    // to 60 GB/s, likwid-bench's and ours alike), so a roof timed for a third of a second beside
+    // a check timed for two seconds compared the minutes (the check caught a fast one more often:
+    // ours at 89% of likwid-bench's in one sitting, 100-105% side by side).
+    const double round_s =
+        likwid ? std::max(seconds / kRoofRounds, kLikwidRunSeconds) : seconds / kRoofRounds;
+    const auto check = [&](LikwidRate& best, LikwidKernel kernel, double expected) {
+      if (!likwid) return;
+      const LikwidRate r = likwid_bench(kernel, bytes, threads, round_s, expected, 1);
+      if (r.rate > best.rate || best.kernel.empty()) best = r;
+    };
     for (int round = 0; round < kRoofRounds; ++round) {
-      roof.read = std::max(roof.read, read_bandwidth(bytes, threads, round_s));
-      roof.write = std::max(roof.write, write_bandwidth(bytes, threads, round_s));
-      roof.update = std::max(roof.update, update_bandwidth(bytes, threads, round_s));
-      roof.zero = std::max(roof.zero, zero_bandwidth(bytes, threads, round_s));
-      if (!likwid) continue;
-      // likwid-bench's runs a fifth of `seconds` each (or kLikwidRunSeconds), not of the round:
-      // its short runs at two threads report less (on the Zen 5 VM, update in L2: 556-668 GB/s
-      // in runs of 13 ms, 735-754 in runs of 130 ms; ours 761).
-      const auto check = [&](LikwidRate& best, LikwidKernel kernel, double expected) {
-        const LikwidRate r = likwid_bench(kernel, bytes, threads, seconds, expected, 2);
-        if (r.rate > best.rate || best.kernel.empty()) best = r;
-      };
-      check(roof.likwid_read, LikwidKernel::load, roof.read);
-      check(roof.likwid_write, LikwidKernel::store, roof.write);
-      check(roof.likwid_update, LikwidKernel::update, roof.update);
+      const double read = read_bandwidth(bytes, threads, round_s);
+      check(roof.likwid_read, LikwidKernel::load, read);
+      const double write = write_bandwidth(bytes, threads, round_s);
+      check(roof.likwid_write, LikwidKernel::store, write);
+      const double update = update_bandwidth(bytes, threads, round_s);
+      check(roof.likwid_update, LikwidKernel::update, update);
+      roof.read = std::max(roof.read, read);
+      roof.write = std::max(roof.write, write);
+      roof.update = std::max(roof.update, update);
+      roof.zero = std::max(roof.zero, zero_bandwidth(bytes, threads, seconds / kRoofRounds));
     }
     roof.eigen_sum = eigen_sum_bandwidth(bytes, threads, seconds);
     // Three arrays in the same working set as the read's one.

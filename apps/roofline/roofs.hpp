@@ -47,7 +47,8 @@ constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
 
 // Every roof at `threads` threads, each kernel run for about `seconds`, with likwid-bench's
 // at the same sizes where `likwid` (and where it is installed). The bandwidth roofs and their
-// checks take turns in kRoofRounds rounds, the best of each kept.
+// checks run back to back, equally long, in kRoofRounds rounds, the best of each kept (with
+// the check, each at least kLikwidRunSeconds a round).
 constexpr int kRoofRounds = 3;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
