@@ -133,31 +133,31 @@ std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, in
   return levels;
 }
 
-double read_bandwidth(std::size_t bytes, int threads, double seconds) {
+double read_bandwidth(std::size_t bytes, int threads, double seconds, int timings) {
   const std::size_t n = elements(bytes);
   const int p = passes(n);
   return best_rate(
       threads, seconds, double(p * n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [p](const Eigen::VectorXd& a) { return read_passes(a, p); });
+      [p](const Eigen::VectorXd& a) { return read_passes(a, p); }, timings);
 }
 
 int read_packets() { return kPackets; }
 
-double write_bandwidth(std::size_t bytes, int threads, double seconds) {
+double write_bandwidth(std::size_t bytes, int threads, double seconds, int timings) {
   const std::size_t n = elements(bytes);
   return best_rate(
       threads, seconds, double(n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [](Eigen::VectorXd& a) { return write_pass(a); });
+      [](Eigen::VectorXd& a) { return write_pass(a); }, timings);
 }
 
-double update_bandwidth(std::size_t bytes, int threads, double seconds) {
+double update_bandwidth(std::size_t bytes, int threads, double seconds, int timings) {
   const std::size_t n = elements(bytes);
   return best_rate(
       threads, seconds, 2.0 * double(n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [](Eigen::VectorXd& a) { return update_pass(a); });
+      [](Eigen::VectorXd& a) { return update_pass(a); }, timings);
 }
 
 double zero_bandwidth(std::size_t bytes, int threads, double seconds) {
@@ -172,12 +172,12 @@ double zero_bandwidth(std::size_t bytes, int threads, double seconds) {
       });
 }
 
-double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds) {
+double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds, int timings) {
   const std::size_t n = elements(bytes);
   return best_rate(
       threads, seconds, double(n * sizeof(double)),
       [n] { return Eigen::VectorXd::Constant(Eigen::Index(n), 1.0).eval(); },
-      [](const Eigen::VectorXd& a) { return a.sum(); });
+      [](const Eigen::VectorXd& a) { return a.sum(); }, timings);
 }
 
 double triad_bandwidth(std::size_t bytes, int threads, double seconds) {

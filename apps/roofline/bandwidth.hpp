@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/roofline/best_rate.hpp"
 #include "common/machine_record.hpp"
 
 namespace fem::roofline {
@@ -42,20 +43,20 @@ struct MemoryLevel {
 std::vector<MemoryLevel> memory_levels(const std::vector<CacheLevel>& caches, int threads);
 
 // The best read bandwidth (bytes/s) of `threads` threads, each loading its own array of
-// `bytes` over and over for about `seconds`: the best of several timed repetitions, since a
+// `bytes` over and over for about `seconds`: the best of `timings` timed repetitions, since a
 // roof is what the machine can do, and a slower repetition only says something else ran.
-double read_bandwidth(std::size_t bytes, int threads, double seconds);
+double read_bandwidth(std::size_t bytes, int threads, double seconds, int timings = kRoofTimings);
 
 // The best write bandwidth (bytes stored per second): every thread fills its own array of
 // `bytes` with packet stores. Where the array is not in the level (memory), each store's
 // line is first read (write-allocate): the roof prices that read with the store.
-double write_bandwidth(std::size_t bytes, int threads, double seconds);
+double write_bandwidth(std::size_t bytes, int threads, double seconds, int timings = kRoofTimings);
 
 // The best update bandwidth (bytes read and written back per second, as likwid-bench's update
 // kernels count them): every thread loads each packet of its own array of `bytes` and stores
 // it back to the same line, which the pass has just read. The store allocates nothing: its
 // line is in the core's cache already, and leaves it written back (dirty) only.
-double update_bandwidth(std::size_t bytes, int threads, double seconds);
+double update_bandwidth(std::size_t bytes, int threads, double seconds, int timings = kRoofTimings);
 
 // The best zeroing bandwidth (bytes zeroed per second): every thread zeroes its own array of
 // `bytes` of 3x3 blocks block by block (Matrix3d::setZero), as compose zeroes A from chapter
@@ -70,7 +71,8 @@ int read_packets();
 
 // The same read, by another kernel: Eigen's own sum (DenseBase::sum, Eigen/src/Core/Redux.h)
 // of a VectorXd per thread. The roof's second, independent measurement.
-double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds);
+double eigen_sum_bandwidth(std::size_t bytes, int threads, double seconds,
+                           int timings = kRoofTimings);
 
 // STREAM's triad a = b + s c on three arrays of `bytes` each, counted as STREAM counts it
 // (24 bytes per element: two reads, one write; the cache line the write first reads is not

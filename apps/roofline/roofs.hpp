@@ -46,10 +46,10 @@ struct Roofs {
 constexpr int kLoadsPerCycle = 2, kFmasPerCycle = 2;
 
 // Every roof at `threads` threads, each kernel run for about `seconds`, with likwid-bench's
-// at the same sizes where `likwid` (and where it is installed). The bandwidth roofs and their
-// checks run back to back, equally long, in kRoofRounds rounds, the best of each kept (with
-// the check, each at least kLikwidRunSeconds a round).
-constexpr int kRoofRounds = 3;
+// at the same sizes where `likwid` (and where it is installed). A bandwidth roof and its check
+// are sampled alike: one timing of ours and one run of likwid-bench's, back to back and at
+// least kLikwidRunSeconds each, in each of kRoofRounds rounds, the best of each kept.
+constexpr int kRoofRounds = 5;
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid);
 
