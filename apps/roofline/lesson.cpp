@@ -1,5 +1,6 @@
 #include "apps/roofline/lesson.hpp"
 
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
@@ -45,13 +46,14 @@ std::vector<Roofs> machine_roofs(const LessonRun& run) {
 }
 
 // How a roof was sampled: beside its likwid-bench check where that ran (measure_roofs).
-std::string sampling(const std::vector<Roofs>& roofs) {
+std::string sampling(const std::vector<Roofs>& roofs, double seconds) {
   const bool checked = !roofs.empty() && !roofs.front().levels.empty() &&
                        roofs.front().levels.front().likwid_read.rate > 0.0;
   std::ostringstream out;
   if (checked)
-    out << "one timing of each roof and one likwid-bench run back to back, " << kLikwidRunSeconds
-        << " s each, in " << kRoofRounds << " rounds, the best of each";
+    out << "one timing of each roof and one likwid-bench run back to back, "
+        << fixed(std::max(seconds / kRoofRounds, kLikwidRunSeconds), 1) << " s each, in "
+        << kRoofRounds << " rounds, the best of each";
   else
     out << "the best of repeated timings in " << kRoofRounds << " rounds";
   return out.str();
@@ -68,8 +70,8 @@ std::string sentence(const LessonRun& run, const std::vector<Roofs>& roofs) {
       << "peak: " << fma_chains() << " independent chains of Eigen packet multiply-adds, "
       << double_lanes() << " doubles or " << float_lanes()
       << " floats per packet); a team timed from the barrier that starts it to the one after its "
-      << "last thread ends, each thread pinned to its own CPU; " << sampling(roofs)
-      << "; working sets from the caches "
+      << "last thread ends, each thread pinned to its own CPU; "
+      << sampling(roofs, run.args.get_double("roof-seconds")) << "; working sets from the caches "
       << "in /sys/devices/system/cpu, a shared cache holding no more than its roofs were "
       << "measured on. " << roofs_check(roofs) << "Chapters: " << run.args.get_int("warmup")
       << " warm-up and " << run.steps << " measured steps, medians; cantilever scene. "

@@ -57,14 +57,14 @@ double field(const std::string& report, const std::string& label) {
 }  // namespace
 
 std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                           double seconds, double expected) {
+                           double run_seconds, double expected) {
   const bool flops = kernel == LikwidKernel::peak;
   // One iteration passes once over a thread's chunk: 8 bytes an element (16 for update, which
   // counts its load and its store), and peakflops_*'s 30 flops an element (likwid-bench -l
   // peakflops_avx512_fma).
   const double per_element = flops ? 30.0 / 8.0 : kernel == LikwidKernel::update ? 2.0 : 1.0;
   const double per_iteration = double(bytes_per_thread) * per_element * std::max(threads, 1);
-  const double run_s = std::max(seconds / kRoofTimings, kLikwidRunSeconds);
+  const double run_s = std::max(run_seconds, kLikwidRunSeconds);
   const long long iterations =
       std::max(10LL, static_cast<long long>(expected * run_s / per_iteration));
   const std::size_t kb = std::max<std::size_t>(1, bytes_per_thread * threads / 1024);
@@ -75,7 +75,7 @@ std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, in
 }
 
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected, int runs) {
+                        double run_seconds, double expected, int runs) {
   LikwidRate r;
   r.kernel = kernel_name(kernel);
   int status = 0;
@@ -85,7 +85,8 @@ LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int t
     return r;
   }
   const bool flops = kernel == LikwidKernel::peak;
-  const std::string command = likwid_command(kernel, bytes_per_thread, threads, seconds, expected);
+  const std::string command =
+      likwid_command(kernel, bytes_per_thread, threads, run_seconds, expected);
   std::string report;
   for (int i = 0; i < runs; ++i) {
     report = run(command, status);

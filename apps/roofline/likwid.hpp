@@ -32,18 +32,18 @@ constexpr double kLikwidRunSeconds = 1.0;
 
 // likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
 // `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), the best of `runs` runs of a fifth of `seconds` each, or
+// `bytes_per_thread` (-W), the best of `runs` runs of `run_seconds` each, or
 // kLikwidRunSeconds if longer (measure_roofs: one in each of its rounds, right after our
 // roof's timing of the same length). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's
 // -s takes whole seconds and reads "0.5" as none, and then runs the least it runs, ten
 // iterations, too short a time for any clock.
 LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                        double seconds, double expected, int runs = kRoofTimings);
+                        double run_seconds, double expected, int runs = kRoofTimings);
 
 // The command line of one of likwid_bench's runs (its iterations from `expected`).
 std::string likwid_command(LikwidKernel kernel, std::size_t bytes_per_thread, int threads,
-                           double seconds, double expected);
+                           double run_seconds, double expected);
 
 // The core's own limit at the clock measured on the spot: `per_cycle` loads (or multiply-
 // adds) of one packet each per cycle, times the packet's bytes (or its 2 flops per lane),

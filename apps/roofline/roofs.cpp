@@ -54,8 +54,8 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
   roofs.peak_double = peak_flops_double(threads, seconds);
   roofs.peak_float = peak_flops_float(threads, seconds);
   if (likwid)
-    roofs.likwid_peak =
-        likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds, roofs.peak_double);
+    roofs.likwid_peak = likwid_bench(LikwidKernel::peak, 16 << 10, threads, seconds / kRoofTimings,
+                                     roofs.peak_double);
   roofs.clock = measured_clock();
   roofs.barrier_s = barrier_seconds(threads);
   roofs.region_s = region_seconds(threads);
