@@ -12,9 +12,13 @@ namespace {
 
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kLanes = Eigen::internal::packet_traits<double>::size;
-// Packets per stride of the read and write loops (a kilobyte with AVX-512, half with AVX2):
-// the loop's own instructions few beside its loads.
-constexpr int kPackets = kLanes >= 8 ? 16 : 8;
+// Packets per stride of the read, write and update loops: four, as likwid-bench's load_*,
+// store_* and update_* kernels (their "Inner loop executions": 16000 for 512000 doubles with
+// AVX-512). Fewer branches do not make a faster loop: on the Zen 5 VM a stride of sixteen
+// 64-byte packets read a 4 MiB array (in L3) at 100-108 GB/s in every run where four
+// packets, likwid-bench's stride, read it at 119-130 and likwid-bench at 119-124 (a scratch
+// copy of this loop, runs of 0.5 s, alternated); in L1 and L2 the two strides ran alike.
+constexpr int kPackets = 4;
 constexpr std::size_t kStride = kPackets * kLanes;
 
 // Elements per thread for `bytes`, whole strides of the read kernel, at least one.
