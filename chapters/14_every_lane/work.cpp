@@ -20,6 +20,20 @@ double float_blocks_bytes(const Fine& fine) {
 
 }  // namespace
 
+ch08::ElementWork element_work(const PrefetchedElementPass&, const ch08::WorkInput& in) {
+  return ch08::fused_pass_work(in);
+}
+
+ExecutedWork element_counters(const PrefetchedElementPass& part, double elements) {
+  const ch12::BatchedElements& e = part.batched_elements();
+  ExecutedWork w;
+  w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;
+  w.rotations = double(e.total_rotations());
+  w.rotation_iterations = double(e.total_newton_iterations());
+  w.rotation_fallbacks = double(e.total_fallbacks());
+  return w;
+}
+
 ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch08::WorkInput& in) {
   ch08::PreconditionerWork w = ch10::multigrid_work(part.multigrid(), in, sizeof(float), true);
   const LaneVCycle& cycle = part.lane_v_cycle();

@@ -164,8 +164,44 @@ TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[
                     ")") != std::string::npos);
   });
   CHECK(text.find("(14_every_lane)") != std::string::npos);
-  CHECK(text.find("(12_half_the_bytes)") != std::string::npos);
+  CHECK(text.find("chapter 12's batches") != std::string::npos);
   CHECK(text.find("finest level in pair lanes") != std::string::npos);
+  // The test scene's A fits in any last cache; a machine that does not say (0) fetches ahead.
+  const bool ahead = stepper.elements().fetches_ahead();
+  CHECK(ahead == (last_cache_bytes() == 0));
+  CHECK(text.find(ahead ? "the next batch fetched ahead" : "no fetching ahead") !=
+        std::string::npos);
+}
+
+TEST_CASE(
+    "ch14: the element pass fills chapter 12's A and b to the bit, fetching ahead or not, on 1, "
+    "2 and 3 threads",
+    "[ch14]") {
+  for (const Scene& scene : test::equivalence_scenes()) {
+    for (const int threads : thread_counts()) {
+      const ThreadCountScope team(threads);
+      ch12::HalfBytesStepper twelve(scene, {});
+      State a = rest_state(scene);
+      twelve.step(a);
+      for (const long long cache_bytes : {0LL, 1LL << 40}) {
+        INFO(scene.name << ", " << threads << " threads, last cache " << cache_bytes);
+        ch08::StepParams<ch14::EveryLane> params;
+        params.elements.cache_bytes = cache_bytes;
+        ch14::EveryLaneStepper fourteen(scene, {}, params);
+        CHECK(fourteen.elements().fetches_ahead() == (cache_bytes == 0));
+        State b = rest_state(scene);
+        fourteen.step(b);
+        const auto& A12 = twelve.system_matrix().blocks;
+        const auto& A14 = fourteen.system_matrix().blocks;
+        REQUIRE(A12.size() == A14.size());
+        bool same = true;
+        for (std::size_t k = 0; k < A12.size(); ++k)
+          same = same && (A12[k].array() == A14[k].array()).all();
+        CHECK(same);
+        CHECK((twelve.system_rhs().array() == fourteen.system_rhs().array()).all());
+      }
+    }
+  }
 }
 
 TEST_CASE("ch14: soak, thousands of steps under a jumping mouse spring, 1 and 2 threads",
