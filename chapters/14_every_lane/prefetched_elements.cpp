@@ -9,10 +9,12 @@ namespace {
 
 // Asks for the lines elements [first, last) will read and write: their blocks of A (72 bytes,
 // two lines where a block straddles one), and x, v and b at their corners. Write intent for
-// what the scatter adds into.
-void fetch_ahead(int first, int last, const std::vector<Eigen::Vector4i>& tets,
-                 const std::vector<std::array<int, 16>>& element_blocks, const State& state,
-                 const ch08::System& system) {
+// what the scatter adds into. Always inlined: as a function of its own, GCC 12 took it for one
+// without effects (a prefetch changes no value) and dropped its calls, prefetches and all (the
+// object held no prefetch instruction, and the beam's pass ran as fast as chapter 12's).
+EIGEN_ALWAYS_INLINE void fetch_ahead(int first, int last, const std::vector<Eigen::Vector4i>& tets,
+                                     const std::vector<std::array<int, 16>>& element_blocks,
+                                     const State& state, const ch08::System& system) {
   for (int e = first; e < last; ++e) {
     for (const int k : element_blocks[e]) {
       const double* block = system.A.blocks[k].data();
