@@ -7,8 +7,8 @@
 
 #include "chapters/08_element_kernels/step.hpp"
 #include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/14_every_lane/lane_scatter.hpp"
 #include "chapters/14_every_lane/lane_v_cycle.hpp"
-#include "chapters/14_every_lane/prefetched_elements.hpp"
 
 namespace fem::ch14 {
 

@@ -1,8 +1,8 @@
 // Chapter 14: every vector lane busy. Chapter 12's step with the V-cycle's finest level in
 // pair lanes (lane_v_cycle.hpp): two 3x3 blocks of a row side by side in one register, where
 // chapter 12 loads one block's column into four of a register's eight or sixteen lanes; and
-// chapter 12's element batches fed ahead where A is larger than the last cache
-// (prefetched_elements.hpp), so that their lanes do not wait on the scatter's lines.
+// chapter 12's element batches scattered into A a register a block, fetched ahead where A is
+// larger than the last cache (lane_scatter.hpp).
 #pragma once
 
 #include "chapters/08_element_kernels/step.hpp"
@@ -17,7 +17,7 @@ namespace fem::ch14 {
 struct EveryLane {
   using Order = ch11::RenumberedNodes;     // chapter 11's
   using Team = ch09::TeamOfThreads;        // chapter 09's
-  using Elements = PrefetchedElementPass;  // new: chapter 12's batches, fetched ahead
+  using Elements = LaneScatterPass;        // new: chapter 12's batches, scattered in lanes
   using Guess = ch10::Extrapolation;       // chapter 10's
   using Preconditioner = LaneMultigrid;    // new: the finest level in pair lanes
   using Solver = ch09::ParallelPcgSolver;  // chapter 09's

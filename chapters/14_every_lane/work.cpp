@@ -20,11 +20,11 @@ double float_blocks_bytes(const Fine& fine) {
 
 }  // namespace
 
-ch08::ElementWork element_work(const PrefetchedElementPass&, const ch08::WorkInput& in) {
+ch08::ElementWork element_work(const LaneScatterPass&, const ch08::WorkInput& in) {
   return ch08::fused_pass_work(in);
 }
 
-ExecutedWork element_counters(const PrefetchedElementPass& part, double elements) {
+ExecutedWork element_counters(const LaneScatterPass& part, double elements) {
   const ch12::BatchedElements& e = part.batched_elements();
   ExecutedWork w;
   w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;

@@ -13,8 +13,8 @@
 namespace fem::ch14 {
 
 // The element pass: chapter 12's (the prefetches add no bytes, only fetch them sooner).
-ch08::ElementWork element_work(const PrefetchedElementPass& part, const ch08::WorkInput& in);
-ExecutedWork element_counters(const PrefetchedElementPass& part, double elements);
+ch08::ElementWork element_work(const LaneScatterPass& part, const ch08::WorkInput& in);
+ExecutedWork element_counters(const LaneScatterPass& part, double elements);
 
 ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch08::WorkInput& in);
 
