@@ -150,7 +150,7 @@ void LaneScatterPass::pass(const ch08::StepInput& in, const State& state, ch08::
 
 void LaneScatterPass::describe(std::ostream& out) const {
   const double mib = 1 << 20;
-  out << "    chapter 12's batches; A " << std::fixed << std::setprecision(1) << a_bytes_ / mib
+  out << "    A " << std::fixed << std::setprecision(1) << a_bytes_ / mib
       << " MiB against a last cache of " << double(cache_bytes_) / mib
       << " MiB: " << (ahead_ ? "the next batch fetched ahead" : "no fetching ahead") << "\n"
       << std::defaultfloat;

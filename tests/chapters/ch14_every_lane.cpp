@@ -164,7 +164,7 @@ TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[
                     ")") != std::string::npos);
   });
   CHECK(text.find("(14_every_lane)") != std::string::npos);
-  CHECK(text.find("chapter 12's batches") != std::string::npos);
+  CHECK(text.find("MiB against a last cache of") != std::string::npos);
   CHECK(text.find("finest level in pair lanes") != std::string::npos);
   // The test scene's A fits in any last cache; a machine that does not say (0) fetches ahead.
   const bool ahead = stepper.elements().fetches_ahead();
