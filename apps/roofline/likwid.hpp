@@ -30,9 +30,10 @@ enum class LikwidKernel { load, store, update, peak };
 // measured its own start, not the cache.
 constexpr double kLikwidRunSeconds = 1.0;
 
-// likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) on
-// `threads` threads of its domain S0, each allocating and touching its own chunk of
-// `bytes_per_thread` (-W), the best of `runs` runs of `run_seconds` each, or
+// likwid-bench's `kernel` at the build's vector width (load_avx512 or load_avx, ...) in
+// `threads` processes of one thread at once, each pinned to its own CPU (the ones this process
+// may use, in order) on its own `bytes_per_thread` (-W), their rates summed; the best of `runs`
+// runs of `run_seconds` each, or
 // kLikwidRunSeconds if longer (measure_roofs: one in each of its rounds, right after our
 // roof's timing of the same length). A run's length is set by its
 // iterations (-i), from `expected` (our own roof's rate, in the kernel's units): likwid-bench's

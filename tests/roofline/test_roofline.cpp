@@ -448,12 +448,15 @@ TEST_CASE(
     "roofline: likwid-bench runs as long as asked or a second if longer, set by its iterations",
     "[roofline]") {
   // 1 MiB a thread at an expected 10 GB/s for the team of 2, a run of 0.1 s raised to
-  // kLikwidRunSeconds (1 s), 10 GB, 2 MiB an iteration: 4768 iterations. -s would
+  // kLikwidRunSeconds (1 s): each of the two processes 5 GB, 1 MiB an iteration, 4768. -s would
   // take whole seconds only ("0.5" is none, and likwid-bench then runs its least, ten).
   using fem::roofline::likwid_command;
   using fem::roofline::LikwidKernel;
   const std::string load = likwid_command(LikwidKernel::load, 1 << 20, 2, 0.1, 10e9);
-  CHECK(load.find(" -W S0:2048kB:2 ") != std::string::npos);
+  // One process of one thread per CPU, each on its own MiB.
+  CHECK(load.find(" -W N:1024kB:1 ") != std::string::npos);
+  CHECK(load.find(" -W N:1024kB:1 ", load.find(" -W N:1024kB:1 ") + 1) != std::string::npos);
+  CHECK(load.find("taskset -c ") != std::string::npos);
   CHECK(load.find(" -i 4768 ") != std::string::npos);
   CHECK(load.find(" -s ") == std::string::npos);
   // A run of 2 s, longer than the least.
