@@ -53,7 +53,8 @@ std::string sampling(const std::vector<Roofs>& roofs, double seconds) {
   if (checked)
     out << "one timing of each roof and one likwid-bench run back to back, "
         << fixed(std::max(seconds / kRoofRounds, kLikwidRunSeconds), 1) << " s each, in "
-        << kRoofRounds << " rounds, the best of each";
+        << kRoofRounds << " rounds, the best of each (likwid-bench one process a thread, "
+        << "each pinned to its CPU, started at once, their rates summed)";
   else
     out << "the best of repeated timings in " << kRoofRounds << " rounds";
   return out.str();
