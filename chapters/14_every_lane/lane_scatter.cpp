@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iomanip>
+#include <sstream>
 
 namespace fem::ch14 {
 
@@ -34,11 +35,10 @@ EIGEN_ALWAYS_INLINE void fetch_ahead(int first, int last, const std::vector<Eige
 // The scatter at the vector width (AVX-512: a block's first eight entries are one register).
 // Chapter 12's scatter takes each lane's nine entries of a block one by one, strided across
 // the batch's registers, and adds them one by one: for a pair of corners and its two blocks,
-// 27 scalar loads and 18 stores. Here each
-// pair's first eight registers of lanes are transposed once a batch into one register a lane
-// (24 shuffles for 8 x 8 doubles); a block is then added by one load, one addition and one
-// store, and its ninth entry alone. The same additions into the same entries in the same order
-// (lane by lane, as chapter 12): the same bits.
+// 27 scalar loads and 18 stores. Here each pair's first eight registers of lanes are
+// transposed once a batch into one register a lane (24 shuffles for 8 x 8 doubles); a block
+// is then added by one load, one addition and one store, and its ninth entry alone. The same
+// additions into the same entries in the same order (lane by lane, as chapter 12): the same bits.
 using Eigen::internal::Packet8d;
 
 // Per lane and pair, K(0,0) .. K(2,1) in row-major order (K(2,2) stays in the terms).
@@ -149,11 +149,13 @@ void LaneScatterPass::pass(const ch08::StepInput& in, const State& state, ch08::
 }
 
 void LaneScatterPass::describe(std::ostream& out) const {
+  // Formatted apart: the stream's precision stays the caller's.
   const double mib = 1 << 20;
-  out << "    A " << std::fixed << std::setprecision(1) << a_bytes_ / mib
-      << " MiB against a last cache of " << double(cache_bytes_) / mib
-      << " MiB: " << (ahead_ ? "the next batch fetched ahead" : "no fetching ahead") << "\n"
-      << std::defaultfloat;
+  std::ostringstream line;
+  line << std::fixed << std::setprecision(1) << "    A " << a_bytes_ / mib
+       << " MiB against a last cache of " << double(cache_bytes_) / mib
+       << " MiB: " << (ahead_ ? "the next batch fetched ahead" : "no fetching ahead") << "\n";
+  out << line.str();
 }
 
 }  // namespace fem::ch14

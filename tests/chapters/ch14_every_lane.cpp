@@ -165,6 +165,8 @@ TEST_CASE("ch14: the printed summary names the lanes' part and chapter 12's", "[
   });
   CHECK(text.find("(14_every_lane)") != std::string::npos);
   CHECK(text.find("MiB against a last cache of") != std::string::npos);
+  // Each part formats its own numbers: none leaves the stream's precision changed for the next.
+  CHECK(text.find("e+") == std::string::npos);
   CHECK(text.find("finest level in pair lanes") != std::string::npos);
   // The test scene's A fits in any last cache; a machine that does not say (0) fetches ahead.
   const bool ahead = stepper.elements().fetches_ahead();
