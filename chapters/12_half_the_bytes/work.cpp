@@ -7,7 +7,10 @@ ch08::ElementWork element_work(const BatchedElementPass&, const ch08::WorkInput&
 }
 
 ExecutedWork element_counters(const BatchedElementPass& part, double elements) {
-  const BatchedElements& e = part.batched_elements();
+  return batch_counters(part.batched_elements(), elements);
+}
+
+ExecutedWork batch_counters(const BatchedElements& e, double elements) {
   ExecutedWork w;
   w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;
   w.rotations = double(e.total_rotations());

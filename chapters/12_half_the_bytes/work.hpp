@@ -20,6 +20,8 @@ ch08::ElementWork element_work(const BatchedElementPass& part, const ch08::WorkI
 // The batched pass's counters: rotations, Newton's iterations (every lane of a batch runs the
 // batch's), fallbacks.
 ExecutedWork element_counters(const BatchedElementPass& part, double elements);
+// The same of any part that runs the batches (chapter 14's too).
+ExecutedWork batch_counters(const BatchedElements& batched, double elements);
 
 template <class Real>
 ch08::PreconditionerWork preconditioner_work(const ReducedMultigrid<Real>& part,

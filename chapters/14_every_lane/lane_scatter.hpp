@@ -2,17 +2,17 @@
 // A at the vector width, and the next batch's lines of memory asked for while this batch's
 // lanes compute. Chapter 12 computes a batch's terms in full registers, then scatters them
 // lane by lane and entry by entry: each element adds sixteen 3x3 blocks into A, each entry a
-// strided load from the batch's registers, a load, an addition and a store, and that takes as
-// long as the terms (`fem_lessons batched-elements`: on the plate the terms 37 ns an element,
-// with the scatter 83). On AVX-512 a block's first eight entries fit one register: each pair's
-// lanes are transposed once a batch, and a block is added by one load, one addition and one
-// store (lane_scatter.cpp). And where A is larger than the last cache (the ~82k-node beam: 81
-// MiB against 32) each block's lines come from memory, the scatter waiting on them (113 ns an
-// element there): the slots are known at set-up (the index's element blocks, chapter 07), so
-// the next batch's sixteen blocks and its corners' x, v and b are prefetched
-// (__builtin_prefetch, GCC and Clang) before this batch's terms. Where A fits, the prefetches
-// would only be instructions (5-10% of the plate's pass): chosen once at set-up from A's size
-// against the last cache the machine reports, as the finest level's layout is.
+// strided load from the batch's registers, a load, an addition and a store, and that takes
+// longer than the terms (chapter 12's `fem_lessons batched-elements` table). On AVX-512 a
+// block's first eight entries fit one register: each pair's lanes are transposed once a batch,
+// and a block is added by one load, one addition and one store (lane_scatter.cpp). And where A
+// is larger than the last cache (the ~82k-node beam's), each block's lines come from memory
+// and the scatter waits on them, the longer the larger the mesh (the same table): the slots
+// are known at set-up (the index's element blocks, chapter 07), so the next batch's sixteen
+// blocks and its corners' x, v and b are prefetched (__builtin_prefetch, GCC and Clang) before
+// this batch's terms. Where A fits, the prefetches would only be instructions (on the plate
+// they slowed the pass): chosen once at set-up from A's size against the last cache the
+// machine reports, as the finest level's layout is.
 #pragma once
 
 #include <ostream>

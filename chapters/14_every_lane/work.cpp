@@ -25,13 +25,7 @@ ch08::ElementWork element_work(const LaneScatterPass&, const ch08::WorkInput& in
 }
 
 ExecutedWork element_counters(const LaneScatterPass& part, double elements) {
-  const ch12::BatchedElements& e = part.batched_elements();
-  ExecutedWork w;
-  w.steps = elements > 0 ? double(e.total_rotations()) / elements : 0.0;
-  w.rotations = double(e.total_rotations());
-  w.rotation_iterations = double(e.total_newton_iterations());
-  w.rotation_fallbacks = double(e.total_fallbacks());
-  return w;
+  return ch12::batch_counters(part.batched_elements(), elements);
 }
 
 ch08::PreconditionerWork preconditioner_work(const LaneMultigrid& part, const ch08::WorkInput& in) {
