@@ -8,12 +8,14 @@
 
 #include "chapters/08_element_kernels/serial_parts.hpp"
 #include "chapters/08_element_kernels/step.hpp"
+#include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/09_threads/parts.hpp"
 #include "chapters/09_threads/threaded_elements.hpp"
 
 namespace fem::ch09 {
 
 struct Threads {
+  using BuildsOn = ch08::ElementKernels;  // the chapter this recipe changes
   using Order = ch08::MeshOrder;          // chapter 08's
   using Team = TeamOfThreads;             // new: every thread
   using Elements = ThreadedElements;      // new: the fused pass on every thread

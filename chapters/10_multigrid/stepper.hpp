@@ -10,12 +10,14 @@
 #include "chapters/08_element_kernels/serial_parts.hpp"
 #include "chapters/08_element_kernels/step.hpp"
 #include "chapters/09_threads/parts.hpp"
+#include "chapters/09_threads/stepper.hpp"
 #include "chapters/09_threads/threaded_elements.hpp"
 #include "chapters/10_multigrid/parts.hpp"
 
 namespace fem::ch10 {
 
 struct MultigridRecipe {
+  using BuildsOn = ch09::Threads;  // the chapter this recipe changes
   using Order = ch08::MeshOrder;                   // chapter 08's
   using Team = ch09::TeamOfThreads;                // chapter 09's
   using Elements = ch09::ThreadedElements;         // chapter 09's

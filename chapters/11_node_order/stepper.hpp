@@ -9,11 +9,13 @@
 #include "chapters/09_threads/parts.hpp"
 #include "chapters/09_threads/threaded_elements.hpp"
 #include "chapters/10_multigrid/parts.hpp"
+#include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/renumbered_nodes.hpp"
 
 namespace fem::ch11 {
 
 struct NodeOrderRecipe {
+  using BuildsOn = ch10::MultigridRecipe;  // the chapter this recipe changes
   using Order = RenumberedNodes;                         // new: reverse Cuthill-McKee
   using Team = ch09::TeamOfThreads;                      // chapter 09's
   using Elements = ch09::ThreadedElements;               // chapter 09's, in slabs

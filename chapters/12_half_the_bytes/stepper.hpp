@@ -9,11 +9,13 @@
 #include "chapters/09_threads/parts.hpp"
 #include "chapters/10_multigrid/parts.hpp"
 #include "chapters/11_node_order/renumbered_nodes.hpp"
+#include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/parts.hpp"
 
 namespace fem::ch12 {
 
 struct HalfTheBytes {
+  using BuildsOn = ch11::NodeOrderRecipe;  // the chapter this recipe changes
   using Order = ch11::RenumberedNodes;             // chapter 11's
   using Team = ch09::TeamOfThreads;                // chapter 09's
   using Elements = BatchedElementPass;             // new: one element per lane

@@ -9,11 +9,13 @@
 #include "chapters/10_multigrid/parts.hpp"
 #include "chapters/11_node_order/renumbered_nodes.hpp"
 #include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/13_fewer_waits/parts.hpp"
 
 namespace fem::ch13 {
 
 struct FewerWaits {
+  using BuildsOn = ch12::HalfTheBytes;  // the chapter this recipe changes
   using Order = ch11::RenumberedNodes;         // chapter 11's
   using Team = ch09::TeamOfThreads;            // chapter 09's
   using Elements = ch12::BatchedElementPass;   // chapter 12's

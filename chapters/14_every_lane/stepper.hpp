@@ -10,11 +10,13 @@
 #include "chapters/10_multigrid/parts.hpp"
 #include "chapters/11_node_order/renumbered_nodes.hpp"
 #include "chapters/12_half_the_bytes/parts.hpp"
+#include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/14_every_lane/parts.hpp"
 
 namespace fem::ch14 {
 
 struct EveryLane {
+  using BuildsOn = ch12::HalfTheBytes;  // the chapter this recipe changes
   using Order = ch11::RenumberedNodes;     // chapter 11's
   using Team = ch09::TeamOfThreads;        // chapter 09's
   using Elements = LaneScatterPass;        // new: chapter 12's batches, scattered in lanes
