@@ -193,14 +193,18 @@ struct ThreadedSolvers {
   const ch09::ThreadsStepper& stepper;
   const SolverSettings& settings;
   ch09::ParallelPcg pcg;
-  ch09::BlockJacobi block_jacobi;
+  ch08::PartSetup setup;
+  ch08::AssembledProduct product;
+  ch09::JacobiOnChunks block_jacobi;
   Eigen::ConjugateGradient<RowMajorMatrix, Eigen::Lower | Eigen::Upper> cg;
 
   ThreadedSolvers(const ch09::ThreadsStepper& s, const Scene& scene, const SolverSettings& set)
       : stepper(s),
         settings(set),
         pcg(s.system_matrix(), scene.constraints),
-        block_jacobi(s.system().index.diagonal) {
+        setup{s.scene(), s.model(), s.system(), s.settings()},
+        product(setup, {}),
+        block_jacobi(setup, {}) {
     cg.setTolerance(settings.tolerance);
     cg.setMaxIterations(settings.max_iterations);
   }
@@ -220,7 +224,8 @@ struct ThreadedSolvers {
       iterations = static_cast<int>(cg.iterations());
     } else {
       x = guess;
-      iterations = pcg.solve(stepper.system_matrix(), block_jacobi, b, settings, x).iterations;
+      iterations =
+          pcg.solve(stepper.system_matrix(), product, block_jacobi, b, settings, x).iterations;
     }
     const double ms = ms_between(start, Clock::now());
     const long long allocations = scope.allocations();

@@ -1,6 +1,9 @@
 // Chapter 08's parts (see serial_parts.hpp), and the system a step builds (step.hpp).
 #include "chapters/08_element_kernels/serial_parts.hpp"
 
+#include <Eigen/LU>
+#include <cassert>
+
 namespace fem::ch08 {
 
 System::System(const Scene& scene, const Model& model)
@@ -35,6 +38,32 @@ void SerialElements::pass(const StepInput& in, const State& state, System& syste
     scatter(tets[e], system.index.element[e], terms, system.A, system.b);
   }
   elements_.end_pass(fallbacks);
+}
+
+void PreconditionerPart::apply_rows(int, int, const Eigen::VectorXd&, Eigen::VectorXd&) const {
+  assert(false && "apply_rows: only a block-diagonal preconditioner applies rows alone");
+}
+
+BlockJacobi::BlockJacobi(const PartSetup& setup, const Params&)
+    : diagonal_block_(setup.system.index.diagonal), inverse_diagonal_(diagonal_block_.size()) {}
+
+void BlockJacobi::invert_rows(const BlockSparseMatrix& A, int first, int last) {
+  for (int i = first; i < last; ++i) inverse_diagonal_[i] = A.blocks[diagonal_block_[i]].inverse();
+}
+
+void BlockJacobi::prepare(const BlockSparseMatrix& A) {
+#pragma omp single
+  invert_rows(A, 0, static_cast<int>(diagonal_block_.size()));
+}
+
+void BlockJacobi::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
+  apply_rows(0, static_cast<int>(diagonal_block_.size()), r, s);
+}
+
+void BlockJacobi::apply_rows(int first, int last, const Eigen::VectorXd& r,
+                             Eigen::VectorXd& s) const {
+  for (int i = first; i < last; ++i)
+    s.segment<3>(3 * i).noalias() = inverse_diagonal_[i] * r.segment<3>(3 * i);
 }
 
 }  // namespace fem::ch08

@@ -6,90 +6,46 @@
 //   (S A S^T + I - S) y = S (b - A z),  dv = y + z.
 // From chapter 08 on the course changes the step's parts, never its order: the nodes'
 // numbering, the team of threads, the element pass (with the start of the system it writes
-// into), the solve's guess, its preconditioner and its solver. A chapter names its parts in a
-// recipe (its stepper.hpp), as Eigen's ConjugateGradient<Matrix, UpLo, Preconditioner> and
-// AMGCL's make_solver<amg<...>, solver::cg<...>> take theirs as types:
+// into), the solve's guess, its product q = A p, its preconditioner and its solver. A chapter
+// names its parts in a recipe (its stepper.hpp), as Eigen's ConjugateGradient<Matrix, UpLo,
+// Preconditioner> and AMGCL's make_solver<amg<...>, solver::cg<...>> take theirs as types:
 //
 //   struct Recipe {
+//     using BuildsOn = ...;        // the recipe this one changes (from chapter 09 on)
 //     using Order = ...;           // the numbering the step runs in (in and out of the caller's)
 //     using Team = ...;            // the threads a step runs on
 //     using Elements = ...;        // compose: A and b's start; forces: the fused element pass
 //     using Guess = ...;           // the solve's first guess from the last solutions
+//     using Product = ...;         // q = A p, as the solver runs it
 //     using Preconditioner = ...;  // M, set up per solve and applied per iteration
 //     using Solver = ...;          // the Krylov iteration that stops at the tolerance
 //   };
 //
-// Each part owns its data and is built from the scene in the step's numbering (PartSetup)
-// and its own Params. A part names itself (kName) and the chapter that teaches it (kChapter,
-// from the folder of the file that declares it), so that the phase table and the printed
-// summary of a stepper come from the recipe, not from reading the code.
+// What each part must provide is contract.hpp's table, checked by check_recipe<Recipe>(): a
+// recipe that lacks a role or a member fails to compile with one sentence naming both. Each
+// part owns its data and is built from the scene in the step's numbering (PartSetup) and its
+// own Params. A part names itself (kName) and the chapter that teaches it (kChapter, from the
+// folder of the file that declares it), so that the phase table and the printed summary of a
+// stepper come from the recipe, not from reading the code.
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <ostream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/08_element_kernels/contract.hpp"
 #include "common/model.hpp"
 #include "common/stepper.hpp"
 
 namespace fem::ch08 {
-
-using ch07::BlockIndex;
-using ch07::BlockSparseMatrix;
-
-// The chapter folder ("09_threads") of a source path (__FILE__ of a part's header): the
-// chapter that teaches the part. A student's variant, a copy of the folder, names itself.
-constexpr std::string_view chapter_of_file(std::string_view file) {
-  const std::size_t at = file.rfind("chapters/");
-  if (at == std::string_view::npos) return "common";
-  const std::string_view rest = file.substr(at + 9);
-  return rest.substr(0, rest.find('/'));
-}
-#define FEM_PART_CHAPTER ::fem::ch08::chapter_of_file(__FILE__)
-
-// The system a step builds and solves, written by the parts in the step's order.
-struct System {
-  BlockSparseMatrix A;         // M - h df/dv - h^2 df/dx, the mesh's block pattern
-  BlockIndex index;            // where element, diagonal and transposed blocks sit in A
-  Eigen::VectorXd b;           // h (f + h df/dx v)
-  Eigen::VectorXd z;           // prescribed velocity change of constrained dofs
-  Eigen::VectorXd filtered_b;  // S (b - A z)
-  Eigen::VectorXd y;           // the filtered system's unknown, dv = y + z: the warm start
-  Eigen::VectorXd dv;
-
-  System(const Scene& scene, const Model& model);
-};
-
-// What every part is built from: the scene and model in the step's numbering, the system's
-// pattern, the solver's settings, and the element groups the order asks for (0: the pass's
-// own choice).
-struct PartSetup {
-  const Scene& scene;
-  const Model& model;
-  const System& system;
-  const SolverSettings& settings;
-  int element_group = 0;
-};
-
-// What the element parts read during a step besides the state.
-struct StepInput {
-  const Scene& scene;
-  const Model& model;
-  const Eigen::SparseVector<double>& f_ext;
-};
-
-// A part as the summaries list it: its role in the recipe, its name and its chapter.
-struct PartName {
-  const char* role;
-  const char* name;
-  std::string_view chapter;
-};
 
 // Every part's Params in one aggregate: `StepParams<R> p; p.preconditioner = ...;`.
 template <class Recipe>
@@ -97,7 +53,9 @@ struct StepParams {
   typename Recipe::Order::Params order{};
   typename Recipe::Elements::Params elements{};
   typename Recipe::Guess::Params guess{};
+  typename Recipe::Product::Params product{};
   typename Recipe::Preconditioner::Params preconditioner{};
+  typename Recipe::Solver::Params solver{};
 };
 
 // A part with more to say than its name (the multigrid's levels) has describe(std::ostream&).
@@ -107,22 +65,31 @@ template <class Part>
 struct HasDescribe<Part, std::void_t<decltype(std::declval<const Part&>().describe(
                              std::declval<std::ostream&>()))>> : std::true_type {};
 
-// The parts' own descriptions, for the parts that have one.
-template <class... Parts>
-void describe_parts(std::ostream& out, const Parts&... parts) {
-  const auto one = [&out](const auto& part) {
-    if constexpr (HasDescribe<std::decay_t<decltype(part)>>::value) part.describe(out);
-  };
-  (one(parts), ...);
-}
+// The step of a whole recipe (below), or, for a recipe that is not whole, a stand-in whose only
+// content is check_recipe's sentences: the compiler reports what the recipe lacks and nothing
+// that follows from it.
+template <class Recipe, bool = recipe_is_whole<Recipe>()>
+class StepOf final : public Stepper {
+  static_assert(check_recipe<Recipe>());
+
+ public:
+  template <class... Arguments>
+  explicit StepOf(Arguments&&...) : Stepper(Scene{}) {}
+  void step(State&) override {}
+  const StepProfile& profile() const override { return profile_; }
+
+ private:
+  StepProfile profile_;
+};
 
 template <class Recipe>
-class StepOf final : public Stepper {
+class StepOf<Recipe, true> final : public Stepper {
  public:
   using Order = typename Recipe::Order;
   using Team = typename Recipe::Team;
   using Elements = typename Recipe::Elements;
   using Guess = typename Recipe::Guess;
+  using Product = typename Recipe::Product;
   using Preconditioner = typename Recipe::Preconditioner;
   using Solver = typename Recipe::Solver;
   using Params = StepParams<Recipe>;
@@ -135,8 +102,9 @@ class StepOf final : public Stepper {
         system_(order_.scene(), model_),
         elements_(setup(), params.elements),
         guess_(setup(), params.guess),
+        product_(setup(), params.product),
         preconditioner_(setup(), params.preconditioner),
-        solver_(setup(), preconditioner_) {
+        solver_(setup(), params.solver) {
     set_external_forces(scene.external_forces);  // in the step's numbering
   }
   StepOf(const StepOf&) = delete;  // the parts hold references into each other and *this
@@ -164,7 +132,7 @@ class StepOf final : public Stepper {
     for_each_part([&out](const PartName& part) {
       out << "  " << part.role << ": " << part.name << " (" << part.chapter << ")\n";
     });
-    describe_parts(out, order_, elements_, preconditioner_);
+    std::apply([&out](const auto&... part) { (describe_part(out, part), ...); }, parts());
   }
 
   // Constraints change while the body runs (a grab, a release, a floor's contacts): the order
@@ -191,6 +159,8 @@ class StepOf final : public Stepper {
   const Team& team() const { return team_; }
   const Elements& elements() const { return elements_; }
   const Guess& guess() const { return guess_; }
+  Product& product() { return product_; }
+  const Product& product() const { return product_; }
   Preconditioner& preconditioner() { return preconditioner_; }
   const Preconditioner& preconditioner() const { return preconditioner_; }
   Solver& solver() { return solver_; }
@@ -199,35 +169,54 @@ class StepOf final : public Stepper {
   const BlockSparseMatrix& system_matrix() const { return system_.A; }
   const Eigen::VectorXd& system_rhs() const { return system_.filtered_b; }
 
+  // f(PartName) for each part, in the recipe's order (contract.hpp's kRoles).
+  template <class F>
+  static void for_each_part(F&& f) {
+    for_each_part(f, std::make_index_sequence<kRoles.size()>{});
+  }
+  // The part that plays `role` (one of kRoles).
+  static PartName part(std::string_view role) {
+    PartName found{"", "", ""};
+    for_each_part([&](const PartName& p) {
+      if (role == p.role) found = p;
+    });
+    return found;
+  }
+
   // Which part runs each of the step's phases (the phase-owners table of chapters/README.md,
   // printed by `fem_lessons phase-owners`): the whole step runs in the order's numbering on the
   // team, the constraints are the step's own (chapter 07's filter in place), the solve is the
-  // guess, the preconditioner and the solver.
+  // guess, the product, the preconditioner and the solver.
   static std::vector<std::pair<const char*, PartName>> phase_owners() {
-    const PartName elements{"elements", Elements::kName, Elements::kChapter};
+    static constexpr std::pair<const char*, const char*> kPhaseRoles[] = {
+        {"step", "order"},       {"step", "team"},
+        {"forces", "elements"},  {"compose", "elements"},
+        {"constraints", "step"}, {"solve", "guess"},
+        {"solve", "product"},    {"solve", "preconditioner"},
+        {"solve", "solver"}};
     const PartName step{"step", "the step, with the constraint filter in place", FEM_PART_CHAPTER};
-    return {{"step", {"order", Order::kName, Order::kChapter}},
-            {"step", {"team", Team::kName, Team::kChapter}},
-            {"forces", elements},
-            {"compose", elements},
-            {"constraints", step},
-            {"solve", {"guess", Guess::kName, Guess::kChapter}},
-            {"solve", {"preconditioner", Preconditioner::kName, Preconditioner::kChapter}},
-            {"solve", {"solver", Solver::kName, Solver::kChapter}}};
-  }
-
-  // f(PartName) for each part, in the recipe's order.
-  template <class F>
-  static void for_each_part(F&& f) {
-    f(PartName{"order", Order::kName, Order::kChapter});
-    f(PartName{"team", Team::kName, Team::kChapter});
-    f(PartName{"elements", Elements::kName, Elements::kChapter});
-    f(PartName{"guess", Guess::kName, Guess::kChapter});
-    f(PartName{"preconditioner", Preconditioner::kName, Preconditioner::kChapter});
-    f(PartName{"solver", Solver::kName, Solver::kChapter});
+    std::vector<std::pair<const char*, PartName>> owners;
+    for (const auto& [phase, role] : kPhaseRoles)
+      owners.push_back({phase, std::string_view(role) == "step" ? step : part(role)});
+    return owners;
   }
 
  private:
+  template <class F, std::size_t... I>
+  static void for_each_part(F& f, std::index_sequence<I...>) {
+    (f(PartName{kRoles[I], std::tuple_element_t<I, RecipeParts<Recipe>>::kName,
+                std::tuple_element_t<I, RecipeParts<Recipe>>::kChapter}),
+     ...);
+  }
+  // The parts themselves, in kRoles' order.
+  auto parts() const {
+    return std::tie(order_, team_, elements_, guess_, product_, preconditioner_, solver_);
+  }
+  template <class Part>
+  static void describe_part(std::ostream& out, const Part& part) {
+    if constexpr (HasDescribe<Part>::value) part.describe(out);
+  }
+
   PartSetup setup() const {
     return {order_.scene(), model_, system_, settings_, order_.element_group()};
   }
@@ -256,7 +245,7 @@ class StepOf final : public Stepper {
     {
       PhaseTimer t(profile_.solve);
       guess_.guess(system_.y);  // y still holds the last step's answer
-      const SolveStats result = solver_.solve(system_, preconditioner_, settings_);
+      const SolveStats result = solver_.solve(system_, product_, preconditioner_, settings_);
       system_.dv = system_.y;
       system_.dv += system_.z;
       profile_.record(result);
@@ -276,6 +265,7 @@ class StepOf final : public Stepper {
   Team team_;
   Elements elements_;
   Guess guess_;
+  Product product_;
   Preconditioner preconditioner_;
   Solver solver_;
 };

@@ -5,8 +5,10 @@
 // from the last steps' rotations, the blocks of -df/dx in closed form from the shape gradients,
 // and one pass over the elements that writes forces and blocks straight into b and A.
 //
-// And it writes the step once, over a recipe of named parts (step.hpp), so that every later
-// chapter changes the step by naming other parts: this recipe is the first.
+// And it writes the step once, over a recipe of named parts (step.hpp), each part bringing what
+// its role needs (contract.hpp), so that every later chapter changes the step by naming other
+// parts: this recipe is the first. Each part's kName and kChapter say what it is and where it is
+// taught; `out << stepper` prints them.
 #pragma once
 
 #include "chapters/08_element_kernels/serial_parts.hpp"
@@ -15,12 +17,13 @@
 namespace fem::ch08 {
 
 struct ElementKernels {
-  using Order = MeshOrder;                // the mesh's numbering
-  using Team = OneThread;                 // one thread
-  using Elements = SerialElements;        // new: the fused element pass
-  using Guess = WarmStart;                // the last solution
-  using Preconditioner = PcgBlockJacobi;  // chapter 07's block Jacobi
-  using Solver = SerialPcg;               // chapter 07's PCG
+  using Order = ch08::MeshOrder;
+  using Team = ch08::OneThread;
+  using Elements = ch08::SerialElements;
+  using Guess = ch08::WarmStart;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch08::BlockJacobi;
+  using Solver = ch08::SerialPcg;
 };
 
 using ElementKernelsStepper = StepOf<ElementKernels>;

@@ -39,21 +39,18 @@ ElementWork fused_pass_work(const WorkInput& in) {
 
 PhaseWork pcg_solve_work(const WorkInput& in, const PreconditionerWork& preconditioner) {
   // The PCG's own kernels as chapter 01 counts them: the product and three vector updates.
-  const double v = in.m.vector_bytes, matrix = ch07::matrix_bytes(in.A);
-  const double entries = 9.0 * double(in.A.blocks.size());
+  const double v = in.m.vector_bytes, matrix = in.product.matrix_bytes;
   const PhaseWork own = ch01::phase_work("pcg", matrix + v + 3 * 2 * v, v + 3 * v, v,
-                                         2 * entries + 10 * in.m.dofs, matrix + 5 * v);
+                                         in.product.flops + 10 * in.m.dofs, matrix + 5 * v);
   return solve_work(in, own, preconditioner);
 }
 
 PhaseWork solve_work(const WorkInput& in, const PhaseWork& own,
                      const PreconditionerWork& preconditioner) {
   PhaseWork solve = ch01::pcg_work(in.m, in.counts.cg_iterations, own, preconditioner.apply);
-  solve.add_part(
-      ch01::phase_work("prepare", preconditioner.prepare_read, preconditioner.prepare_written,
-                       preconditioner.prepare_written, 0.0,
-                       preconditioner.prepare_read + preconditioner.prepare_written),
-      1.0);
+  const double read = preconditioner.prepare_read + in.product.prepare_read;
+  const double written = preconditioner.prepare_written + in.product.prepare_written;
+  solve.add_part(ch01::phase_work("prepare", read, written, written, 0.0, read + written), 1.0);
   return solve;
 }
 
@@ -63,7 +60,12 @@ PreconditionerWork block_jacobi_work(const WorkInput& in) {
 
 ElementWork element_work(const SerialElements&, const WorkInput& in) { return fused_pass_work(in); }
 
-PreconditionerWork preconditioner_work(const PcgBlockJacobi&, const WorkInput& in) {
+ProductWork product_work(const AssembledProduct&, const BlockSparseMatrix& A) {
+  // The blocks, their column indices and row starts (ch07::matrix_bytes), 2 flops an entry.
+  return {ch07::matrix_bytes(A), 2.0 * 9.0 * double(A.blocks.size())};
+}
+
+PreconditionerWork preconditioner_work(const BlockJacobi&, const WorkInput& in) {
   return block_jacobi_work(in);
 }
 

@@ -2,6 +2,7 @@
 // of parts (step.hpp) is counted as the sum of what its parts count, each part's count in the
 // chapter that teaches it (that chapter's work.hpp, found by argument-dependent lookup):
 //   element_work(elements, in)            the phases forces and compose
+//   product_work(product, A)              one q = A p, and its set-up per solve
 //   preconditioner_work(preconditioner, in) one application, and its set-up per solve
 //   solver_work(solver, in, preconditioner) the solve phase
 //   element_counters(elements, elements_count), team_size(team): what the parts ran
@@ -18,12 +19,20 @@
 
 namespace fem::ch08 {
 
+// A product part: one q = A p (the matrix it streams and its flops), and what its set-up per
+// solve reads and writes (a copy of A into another layout).
+struct ProductWork {
+  double matrix_bytes = 0.0, flops = 0.0;
+  double prepare_read = 0.0, prepare_written = 0.0;
+};
+
 // What every part's count reads.
 struct WorkInput {
   const ch01::MeshSizes& m;
   const BlockSparseMatrix& A;
   const Scene& scene;
   const WorkCounts& counts;
+  ProductWork product;  // the recipe's product's (product_work)
 };
 
 // An element part's two phases.
@@ -47,7 +56,8 @@ PhaseWork solve_work(const WorkInput& in, const PhaseWork& own,
                      const PreconditionerWork& preconditioner);
 
 ElementWork element_work(const SerialElements& part, const WorkInput& in);
-PreconditionerWork preconditioner_work(const PcgBlockJacobi& part, const WorkInput& in);
+ProductWork product_work(const AssembledProduct& part, const BlockSparseMatrix& A);
+PreconditionerWork preconditioner_work(const BlockJacobi& part, const WorkInput& in);
 PhaseWork solver_work(const SerialPcg& part, const WorkInput& in,
                       const PreconditionerWork& preconditioner);
 ExecutedWork element_counters(const SerialElements& part, double elements);
@@ -62,7 +72,8 @@ template <class Recipe>
 std::vector<PhaseWork> count_work(const StepOf<Recipe>& stepper, const Scene& scene,
                                   const WorkCounts& counts) {
   const ch01::MeshSizes m = ch01::mesh_sizes(scene);
-  const WorkInput in{m, stepper.system_matrix(), scene, counts};
+  const WorkInput in{m, stepper.system_matrix(), scene, counts,
+                     product_work(stepper.product(), stepper.system_matrix())};
   const ElementWork elements = element_work(stepper.elements(), in);
   const PreconditionerWork preconditioner = preconditioner_work(stepper.preconditioner(), in);
   return {elements.forces, elements.compose,
@@ -70,16 +81,19 @@ std::vector<PhaseWork> count_work(const StepOf<Recipe>& stepper, const Scene& sc
           solver_work(stepper.solver(), in, preconditioner)};
 }
 
-// What a part's kernels alone are built from: `passes` PCG passes a step (iterations + 1).
+// What a part's kernels alone are built from: `passes` PCG passes a step (iterations + 1), and
+// the recipe's product, which the solver's kernels run.
 struct KernelInput {
   const ch01::MeshSizes& m;
   const BlockSparseMatrix& A;
   const Scene& scene;
   double passes;
+  ProductPart& product;
+  ProductWork product_work;
 };
 // Chapter 08's solve runs on one thread: the roofline's kernels alone start with chapter 09's.
 inline std::vector<PartKernel> solver_kernels(SerialPcg&, const KernelInput&) { return {}; }
-inline std::vector<PartKernel> preconditioner_kernels(PcgBlockJacobi&, const KernelInput&) {
+inline std::vector<PartKernel> preconditioner_kernels(BlockJacobi&, const KernelInput&) {
   return {};
 }
 
@@ -90,7 +104,12 @@ template <class Recipe>
 std::vector<PartKernel> solve_kernels(StepOf<Recipe>& stepper, const Scene& scene,
                                       double iterations) {
   const ch01::MeshSizes m = ch01::mesh_sizes(scene);
-  const KernelInput in{m, stepper.system_matrix(), scene, iterations + 1.0};
+  const KernelInput in{m,
+                       stepper.system_matrix(),
+                       scene,
+                       iterations + 1.0,
+                       stepper.product(),
+                       product_work(stepper.product(), stepper.system_matrix())};
   std::vector<PartKernel> kernels = solver_kernels(stepper.solver(), in);
   for (PartKernel& k : preconditioner_kernels(stepper.preconditioner(), in))
     kernels.push_back(std::move(k));

@@ -2,7 +2,6 @@
 // over the fixed chunks per step of the iteration, sums in chunk order.
 #include "chapters/09_threads/parallel_pcg.hpp"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -23,30 +22,31 @@ double sum_in_order(const std::vector<double>& partial) {
   return sum;
 }
 
-// ---- preconditioners --------------------------------------------------------------------
+// ---- the kernels -------------------------------------------------------------------------
 
-void Preconditioner::apply_rows(int, int, const Eigen::VectorXd&, Eigen::VectorXd&) const {}
-
-void Preconditioner::apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-  for (const int c : StaticShare(chunks.count()))
-    apply_rows(chunks.start[c], chunks.start[c + 1], r, s);
+double pcg_product(const ch08::ProductPart& A, const Eigen::VectorXd& p, Eigen::VectorXd& q,
+                   int first, int last) {
+  A.multiply_rows(p, q, first, last);
+  return p.segment(3 * first, 3 * (last - first)).dot(q.segment(3 * first, 3 * (last - first)));
 }
 
-BlockJacobi::BlockJacobi(const std::vector<int>& diagonal_block)
-    : diagonal_block_(diagonal_block), inverse_diagonal_(diagonal_block.size()) {}
-
-void BlockJacobi::prepare(const BlockSparseMatrix& A, const RowChunks& chunks) {
-  // The diagonal blocks of the filtered matrix are symmetric positive definite (a fixed
-  // node's is the identity): a fixed-size 3x3 inverse each.
-  for (const int c : StaticShare(chunks.count()))
-    for (int i = chunks.start[c]; i < chunks.start[c + 1]; ++i)
-      inverse_diagonal_[i] = A.blocks[diagonal_block_[i]].inverse();
+double pcg_update(double step, const Eigen::VectorXd& p, const Eigen::VectorXd& q,
+                  Eigen::VectorXd& y, Eigen::VectorXd& r, const ChunkFilter& filter, int first,
+                  int last) {
+  // Every vector operation of the iteration that needs no neighbour, on one chunk at a time
+  // while it sits in L1. Each is an Eigen expression on the chunk's segment, so it keeps the
+  // SIMD of the whole-vector operations of the chapters before.
+  const int f = 3 * first, size = 3 * (last - first);
+  y.segment(f, size) += step * p.segment(f, size);
+  r.segment(f, size) -= step * q.segment(f, size);
+  filter(r);
+  return r.segment(f, size).squaredNorm();
 }
 
-void BlockJacobi::apply_rows(int first, int last, const Eigen::VectorXd& r,
-                             Eigen::VectorXd& s) const {
-  for (int i = first; i < last; ++i)
-    s.segment<3>(3 * i).noalias() = inverse_diagonal_[i] * r.segment<3>(3 * i);
+void pcg_next_direction(double beta, const Eigen::VectorXd& s, Eigen::VectorXd& p, int first,
+                        int last) {
+  const int f = 3 * first, size = 3 * (last - first);
+  p.segment(f, size) = s.segment(f, size) + beta * p.segment(f, size);
 }
 
 // ---- the solver ---------------------------------------------------------------------------
@@ -78,27 +78,28 @@ ParallelPcg::ParallelPcg(const BlockSparseMatrix& pattern,
     partial->assign(chunks_.count(), 0.0);
 }
 
-SolveStats ParallelPcg::solve(const BlockSparseMatrix& A, Preconditioner& M,
-                              const Eigen::VectorXd& b, const SolverSettings& settings,
-                              Eigen::VectorXd& y) {
+SolveStats ParallelPcg::solve(const BlockSparseMatrix& A, ch08::ProductPart& product,
+                              ch08::PreconditionerPart& M, const Eigen::VectorXd& b,
+                              const SolverSettings& settings, Eigen::VectorXd& y) {
   for (Eigen::VectorXd* v : {&r_, &s_, &p_, &q_}) v->resize(b.size());  // allocates once
   SolveStats result;
   run_parallel([&] {
     // Everything below runs on every thread. The scalars (norms, rho, the step) are each
     // thread's own copy, added up from the same partial sums in the same order: equal on
     // every thread, so every thread takes the same branches.
-    M.prepare(A, chunks_);
+    product.prepare(A);
+    M.prepare(A);
     const double rhs_norm2 = filter_guess(b, y);
-    const SolveStats stats = iterate(A, M, b, rhs_norm2, settings, y);
+    const SolveStats stats = iterate(product, M, b, rhs_norm2, settings, y);
 #pragma omp master
     result = stats;
   });
   return result;
 }
 
-SolveStats ParallelPcg::iterate(const BlockSparseMatrix& A, Preconditioner& M,
-                                const Eigen::VectorXd& b, double rhs_norm2,
-                                const SolverSettings& settings, Eigen::VectorXd& y) {
+SolveStats ParallelPcg::iterate(const Product& A, Preconditioner& M, const Eigen::VectorXd& b,
+                                double rhs_norm2, const SolverSettings& settings,
+                                Eigen::VectorXd& y) {
   SolveStats stats;
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
     for (const int c : StaticShare(chunks_.count()))
@@ -136,35 +137,28 @@ SolveStats ParallelPcg::iterate(const BlockSparseMatrix& A, Preconditioner& M,
   return stats;
 }
 
-void ParallelPcg::filter(int c, Eigen::VectorXd& v) const {
-  for (int k = constraint_start_[c]; k < constraint_start_[c + 1]; ++k) {
-    const NodeConstraint& constraint = constraints_[k];
-    v.segment<3>(3 * constraint.node) = constraint.filter * v.segment<3>(3 * constraint.node);
-  }
-}
-
 void ParallelPcg::precondition_chunk(const Preconditioner& M, int c, Eigen::VectorXd& s) {
   M.apply_rows(chunks_.start[c], chunks_.start[c + 1], r_, s);
-  filter(c, s);
+  filter(c)(s);
   partial_rs_[c] = r_.segment(chunks_.first_dof(c), chunks_.dofs(c))
                        .dot(s.segment(chunks_.first_dof(c), chunks_.dofs(c)));
 }
 
 double ParallelPcg::filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y) {
   for (const int c : StaticShare(chunks_.count())) {
-    filter(c, y);
+    filter(c)(y);
     partial_bb_[c] = b.segment(chunks_.first_dof(c), chunks_.dofs(c)).squaredNorm();
   }
   return sum_in_order(partial_bb_);
 }
 
-double ParallelPcg::residual(const BlockSparseMatrix& A, const Preconditioner& M,
-                             const Eigen::VectorXd& b, const Eigen::VectorXd& y) {
+double ParallelPcg::residual(const Product& A, const Preconditioner& M, const Eigen::VectorXd& b,
+                             const Eigen::VectorXd& y) {
   for (const int c : StaticShare(chunks_.count())) {
     const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
     A.multiply_rows(y, q_, chunks_.start[c], chunks_.start[c + 1]);
     r_.segment(first, size) = b.segment(first, size) - q_.segment(first, size);
-    filter(c, r_);
+    filter(c)(r_);
     if (M.block_diagonal()) precondition_chunk(M, c, p_);
     partial_rr_[c] = r_.segment(first, size).squaredNorm();
   }
@@ -173,46 +167,36 @@ double ParallelPcg::residual(const BlockSparseMatrix& A, const Preconditioner& M
 
 double ParallelPcg::precondition(Preconditioner& M, Eigen::VectorXd& s) {
   // M reads r of every row: it starts after the barrier that ended r's update.
-  M.apply(chunks_, r_, s);
+  M.apply(r_, s);
   for (const int c : StaticShare(chunks_.count())) {
-    filter(c, s);
+    filter(c)(s);
     partial_rs_[c] = r_.segment(chunks_.first_dof(c), chunks_.dofs(c))
                          .dot(s.segment(chunks_.first_dof(c), chunks_.dofs(c)));
   }
   return sum_in_order(partial_rs_);
 }
 
-double ParallelPcg::product(const BlockSparseMatrix& A) {
+double ParallelPcg::product(const Product& A) {
   // q = A p reads p of the neighbouring rows: the barrier that ended p's update comes first.
-  for (const int c : StaticShare(chunks_.count())) {
-    A.multiply_rows(p_, q_, chunks_.start[c], chunks_.start[c + 1]);
-    partial_pq_[c] = p_.segment(chunks_.first_dof(c), chunks_.dofs(c))
-                         .dot(q_.segment(chunks_.first_dof(c), chunks_.dofs(c)));
-  }
+  for (const int c : StaticShare(chunks_.count()))
+    partial_pq_[c] = pcg_product(A, p_, q_, chunks_.start[c], chunks_.start[c + 1]);
   return sum_in_order(partial_pq_);
 }
 
 double ParallelPcg::update(const Preconditioner& M, double step, Eigen::VectorXd& y) {
-  // Every vector operation of the iteration that needs no neighbour, on one chunk at a time
-  // while it sits in L1: y += step p, r -= step q, r filtered, ||r||^2, and for a
-  // block-diagonal M also s = S M r and r . s. Each is an Eigen expression on the chunk's
-  // segment, so it keeps the SIMD of the whole-vector operations of the chapters before.
+  // y, r and ||r||^2 chunk by chunk, and for a block-diagonal M also s = S M r and r . s on the
+  // chunk's rows while they sit in L1.
   for (const int c : StaticShare(chunks_.count())) {
-    const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
-    y.segment(first, size) += step * p_.segment(first, size);
-    r_.segment(first, size) -= step * q_.segment(first, size);
-    filter(c, r_);
+    partial_rr_[c] =
+        pcg_update(step, p_, q_, y, r_, filter(c), chunks_.start[c], chunks_.start[c + 1]);
     if (M.block_diagonal()) precondition_chunk(M, c, s_);
-    partial_rr_[c] = r_.segment(first, size).squaredNorm();
   }
   return sum_in_order(partial_rr_);
 }
 
 void ParallelPcg::next_direction(double beta) {
-  for (const int c : StaticShare(chunks_.count())) {
-    const int first = chunks_.first_dof(c), size = chunks_.dofs(c);
-    p_.segment(first, size) = s_.segment(first, size) + beta * p_.segment(first, size);
-  }
+  for (const int c : StaticShare(chunks_.count()))
+    pcg_next_direction(beta, s_, p_, chunks_.start[c], chunks_.start[c + 1]);
 }
 
 }  // namespace fem::ch09

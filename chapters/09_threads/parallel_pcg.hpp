@@ -2,14 +2,15 @@
 // into a FIXED set of chunks (RowChunks); every parallel loop over rows shares out those
 // chunks, and every sum over the mesh is a sum of per-chunk sums added in chunk order, never
 // an OpenMP reduction (whose order of combination OpenMP leaves unspecified). So the solve
-// gives the same bits for any thread count. The preconditioner is a parameter (block Jacobi
-// here): any Preconditioner that keeps the same rules.
+// gives the same bits for any thread count. The product and the preconditioner are parts
+// (chapter 08's faces, contract.hpp): any that keep the same rules.
 #pragma once
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/08_element_kernels/contract.hpp"
 #include "common/stepper.hpp"
 
 namespace fem::ch09 {
@@ -38,41 +39,36 @@ struct RowChunks {
 // result from one thread to the others.
 double sum_in_order(const std::vector<double>& partial);
 
-// s = M r for the PCG. Every member is called by every thread of the solve's team (inside
-// its parallel region): the work is shared out by orphaned `omp for` or `omp single`
-// constructs, each ending with a barrier.
-class Preconditioner {
- public:
-  virtual ~Preconditioner() = default;
-  // This solve's numbers from A, before the first apply.
-  virtual void prepare(const BlockSparseMatrix& A, const RowChunks& chunks) = 0;
-  // A block-diagonal M reads only the rows it writes: the PCG applies it chunk by chunk inside
-  // its own loops, with no barrier of its own (apply_rows). Any other M sees the whole
-  // residual, after a barrier (apply).
-  virtual bool block_diagonal() const = 0;
-  virtual void apply_rows(int first, int last, const Eigen::VectorXd& r, Eigen::VectorXd& s) const;
-  virtual void apply(const RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s);
-};
-
 // The constraints sorted by node into `sorted`, and where each part's begin there: part p (its
 // rows start[p] .. start[p + 1] - 1) holds sorted[first[p]] .. sorted[first[p + 1] - 1].
 void constraints_by_part(const std::vector<NodeConstraint>& constraints,
                          const std::vector<int>& start, std::vector<NodeConstraint>& sorted,
                          std::vector<int>& first);
 
-// Block Jacobi, s_i = D_i^-1 r_i with D_i the 3x3 diagonal block: chapter 07's, per chunk.
-class BlockJacobi final : public Preconditioner {
- public:
-  BlockJacobi() = default;
-  explicit BlockJacobi(const std::vector<int>& diagonal_block);
-  void prepare(const BlockSparseMatrix& A, const RowChunks& chunks) override;
-  bool block_diagonal() const override { return true; }
-  void apply_rows(int first, int last, const Eigen::VectorXd& r, Eigen::VectorXd& s) const override;
-
- private:
-  std::vector<int> diagonal_block_;
-  std::vector<Eigen::Matrix3d> inverse_diagonal_;  // (A_ii)^-1
+// The constraints of rows [first, last) among `sorted` (constraints_by_part), as a filter.
+struct ChunkFilter {
+  const NodeConstraint* begin = nullptr;
+  const NodeConstraint* end = nullptr;
+  // v_i <- S_i v_i on the constrained nodes: the PPCG projection.
+  void operator()(Eigen::VectorXd& v) const {
+    for (const NodeConstraint* c = begin; c != end; ++c)
+      v.segment<3>(3 * c->node) = c->filter * v.segment<3>(3 * c->node);
+  }
 };
+
+// The PCG's kernels on the block rows [first, last) of one chunk, each returning the chunk's
+// part of the sum it ends with. ParallelPcg's loops call them, and so does the roofline's
+// kernels alone (work.cpp): what it times is what the solve runs.
+//   q = A p; p . q
+double pcg_product(const ch08::ProductPart& A, const Eigen::VectorXd& p, Eigen::VectorXd& q,
+                   int first, int last);
+//   y += step p, r -= step q, r filtered; r . r
+double pcg_update(double step, const Eigen::VectorXd& p, const Eigen::VectorXd& q,
+                  Eigen::VectorXd& y, Eigen::VectorXd& r, const ChunkFilter& filter, int first,
+                  int last);
+//   p = s + beta p
+void pcg_next_direction(double beta, const Eigen::VectorXd& s, Eigen::VectorXd& p, int first,
+                        int last);
 
 // Preconditioned CG on the filtered block system, with the same stopping rule and PPCG filter
 // as chapter 06, in one parallel region. Set up once per pattern and set of constraints; the
@@ -83,26 +79,34 @@ class ParallelPcg {
   ParallelPcg(const BlockSparseMatrix& pattern, const std::vector<NodeConstraint>& constraints);
   // The filter's constraints from the next solve on (a grab, a release, a floor's contacts).
   void set_constraints(const std::vector<NodeConstraint>& constraints);
-  // y holds the initial guess on entry and the solution on exit.
-  SolveStats solve(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
+  // y holds the initial guess on entry and the solution on exit; A is the system the product
+  // and the preconditioner prepare from.
+  SolveStats solve(const BlockSparseMatrix& A, ch08::ProductPart& product,
+                   ch08::PreconditionerPart& M, const Eigen::VectorXd& b,
                    const SolverSettings& settings, Eigen::VectorXd& y);
+  const RowChunks& chunks() const { return chunks_; }
 
  private:
+  using Product = ch08::ProductPart;
+  using Preconditioner = ch08::PreconditionerPart;
   // The steps of one solve, each called by every thread and each one `omp for` over the
   // chunks (so one barrier): they return the sum over the mesh, the same on every thread.
-  SolveStats iterate(const BlockSparseMatrix& A, Preconditioner& M, const Eigen::VectorXd& b,
+  SolveStats iterate(const Product& A, Preconditioner& M, const Eigen::VectorXd& b,
                      double rhs_norm2, const SolverSettings& settings, Eigen::VectorXd& y);
   double filter_guess(const Eigen::VectorXd& b, Eigen::VectorXd& y);  // S y; ||b||^2
-  double residual(const BlockSparseMatrix& A, const Preconditioner& M, const Eigen::VectorXd& b,
+  double residual(const Product& A, const Preconditioner& M, const Eigen::VectorXd& b,
                   const Eigen::VectorXd& y);                   // r = S (b - A y); ||r||^2
   double precondition(Preconditioner& M, Eigen::VectorXd& s);  // s = S M r; r . s
-  double product(const BlockSparseMatrix& A);                  // q = A p; p . q
+  double product(const Product& A);                            // q = A p; p . q
   double update(const Preconditioner& M, double step, Eigen::VectorXd& y);  // y, r; ||r||^2
   void next_direction(double beta);                                         // p = s + beta p
   // Chunk c's share of the block-diagonal M: s = S M r on its rows, and its part of r . s.
   void precondition_chunk(const Preconditioner& M, int c, Eigen::VectorXd& s);
-  // v_i <- S_i v_i on the constrained nodes of chunk c: the PPCG projection.
-  void filter(int c, Eigen::VectorXd& v) const;
+  // The PPCG projection on the constrained nodes of chunk c.
+  ChunkFilter filter(int c) const {
+    return {constraints_.data() + constraint_start_[c],
+            constraints_.data() + constraint_start_[c + 1]};
+  }
 
   RowChunks chunks_;
   // The constraints sorted by node: chunk c's are constraints_[constraint_start_[c] ..].

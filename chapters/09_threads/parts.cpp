@@ -1,9 +1,10 @@
-// Chapter 09's team (see parts.hpp).
+// Chapter 09's team and block Jacobi on the row chunks (see parts.hpp).
 #include "chapters/09_threads/parts.hpp"
 
 #include <cstdlib>
 #include <cstring>
 
+#include "chapters/09_threads/parallel.hpp"
 #include "common/threads.hpp"
 
 namespace fem::ch09 {
@@ -29,6 +30,16 @@ int TeamOfThreads::begin() {
 void TeamOfThreads::end(int given, double step_seconds) {
   if (team_ != given) set_threads(given);
   adaptive_team_.record(step_seconds);
+}
+
+void JacobiOnChunks::prepare(const BlockSparseMatrix& A) {
+  for (const int c : StaticShare(chunks_.count()))
+    invert_rows(A, chunks_.start[c], chunks_.start[c + 1]);
+}
+
+void JacobiOnChunks::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
+  for (const int c : StaticShare(chunks_.count()))
+    apply_rows(chunks_.start[c], chunks_.start[c + 1], r, s);
 }
 
 }  // namespace fem::ch09

@@ -1,9 +1,10 @@
 // Chapter 09's other parts: the team a step runs on, block Jacobi on the fixed row chunks, and
-// the parallel PCG (parallel_pcg.hpp) that applies any chapter 09 Preconditioner.
+// the parallel PCG (parallel_pcg.hpp) with any product and any preconditioner part.
 #pragma once
 
 #include <Eigen/Core>
 
+#include "chapters/08_element_kernels/serial_parts.hpp"
 #include "chapters/08_element_kernels/step.hpp"
 #include "chapters/09_threads/adaptive_team.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
@@ -39,34 +40,37 @@ class TeamOfThreads {
   int team_ = 0;
 };
 
-// Preconditioner: block Jacobi, s_i = D_i^-1 r_i, chunk by chunk inside the PCG's loops.
-class JacobiOnChunks {
+// Preconditioner: chapter 08's block Jacobi, its inverses computed by the whole team, chunk by
+// chunk (applied inside the PCG's loops, as any block-diagonal part is).
+class JacobiOnChunks final : public ch08::BlockJacobi {
  public:
-  struct Params {};
   static constexpr const char* kName = "block Jacobi on the row chunks";
   static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
 
-  JacobiOnChunks(const ch08::PartSetup& setup, const Params&)
-      : jacobi_(setup.system.index.diagonal) {}
-  Preconditioner& pcg_preconditioner() { return jacobi_; }
+  JacobiOnChunks(const ch08::PartSetup& setup, const Params& params)
+      : BlockJacobi(setup, params), chunks_(setup.system.A) {}
+  // By every thread of the solve's team, each inverting its chunks' diagonal blocks.
+  void prepare(const BlockSparseMatrix& A) override;
+  // Outside a team (chapter 08's solver, the kernels alone), the whole vector on this thread.
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+  const RowChunks& chunks() const { return chunks_; }
 
  private:
-  BlockJacobi jacobi_;
+  RowChunks chunks_;
 };
 
-// Solver: the parallel PCG with the recipe's preconditioner.
+// Solver: the parallel PCG with the recipe's product and preconditioner.
 class ParallelPcgSolver {
  public:
+  struct Params {};
   static constexpr const char* kName = "parallel PCG, three barriers an iteration";
   static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
 
-  template <class Part>
-  ParallelPcgSolver(const ch08::PartSetup& setup, Part&)
+  ParallelPcgSolver(const ch08::PartSetup& setup, const Params&)
       : pcg_(setup.system.A, setup.scene.constraints) {}
-  template <class Part>
-  SolveStats solve(ch08::System& system, Part& preconditioner, const SolverSettings& settings) {
-    return pcg_.solve(system.A, preconditioner.pcg_preconditioner(), system.filtered_b, settings,
-                      system.y);
+  SolveStats solve(ch08::System& system, ch08::ProductPart& product,
+                   ch08::PreconditionerPart& preconditioner, const SolverSettings& settings) {
+    return pcg_.solve(system.A, product, preconditioner, system.filtered_b, settings, system.y);
   }
   void set_constraints(const std::vector<NodeConstraint>& constraints) {
     pcg_.set_constraints(constraints);

@@ -15,13 +15,14 @@
 namespace fem::ch09 {
 
 struct Threads {
-  using BuildsOn = ch08::ElementKernels;  // the chapter this recipe changes
-  using Order = ch08::MeshOrder;          // chapter 08's
-  using Team = TeamOfThreads;             // new: every thread
-  using Elements = ThreadedElements;      // new: the fused pass on every thread
-  using Guess = ch08::WarmStart;          // chapter 08's
-  using Preconditioner = JacobiOnChunks;  // new: block Jacobi on the row chunks
-  using Solver = ParallelPcgSolver;       // new: the parallel PCG
+  using BuildsOn = ch08::ElementKernels;
+  using Order = ch08::MeshOrder;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch09::ThreadedElements;
+  using Guess = ch08::WarmStart;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch09::JacobiOnChunks;
+  using Solver = ch09::ParallelPcgSolver;
 };
 
 using ThreadsStepper = ch08::StepOf<Threads>;

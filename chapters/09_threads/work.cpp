@@ -35,7 +35,7 @@ namespace {
 struct PcgVectors {
   RowChunks chunks;
   Eigen::VectorXd y, r, s, p, q;
-  std::vector<double> rr, rs;
+  std::vector<double> rr, pq;
 };
 
 std::shared_ptr<PcgVectors> pcg_vectors(const BlockSparseMatrix& A) {
@@ -46,7 +46,7 @@ std::shared_ptr<PcgVectors> pcg_vectors(const BlockSparseMatrix& A) {
   for (Eigen::VectorXd* x : {&v->y, &v->r, &v->s, &v->p, &v->q})
     *x = Eigen::VectorXd::LinSpaced(n, 1e-3, 1.0);
   v->rr.assign(v->chunks.count(), 0.0);
-  v->rs.assign(v->chunks.count(), 0.0);
+  v->pq.assign(v->chunks.count(), 0.0);
   return v;
 }
 
@@ -64,36 +64,38 @@ PartKernel part_kernel(const std::string& name, const std::string& part, const P
 }
 
 std::vector<PartKernel> solver_kernels(ParallelPcgSolver&, const ch08::KernelInput& in) {
-  const BlockSparseMatrix& A = in.A;
-  const auto v = pcg_vectors(A);
+  const auto v = pcg_vectors(in.A);
   const double vector = 8.0 * double(v->p.size()), dofs = double(v->p.size());
-  const double matrix = ch07::matrix_bytes(A), entries = 9.0 * double(A.blocks.size());
+  const double matrix = in.product_work.matrix_bytes;
   const PhaseWork product = ch01::phase_work("product", matrix + vector, vector, vector,
-                                             2 * entries, matrix + 2 * vector);
-  const PhaseWork updates =
-      ch01::phase_work("updates", 6 * vector, 3 * vector, 0.0, 10 * dofs, 5 * vector);
-  return {part_kernel("product q = A p", "pcg", product, in.passes,
-                      [v, &A] {
+                                             in.product_work.flops + 2 * dofs, matrix + 2 * vector);
+  const PhaseWork update =
+      ch01::phase_work("update", 4 * vector, 2 * vector, 0.0, 6 * dofs, 4 * vector);
+  const PhaseWork next =
+      ch01::phase_work("next direction", 2 * vector, vector, 0.0, 2 * dofs, 2 * vector);
+  const ch08::ProductPart* A = &in.product;
+  return {part_kernel("product q = A p and p . q", "pcg", product, in.passes,
+                      [v, A] {
                         for (const int c : StaticShare(v->chunks.count()))
-                          A.multiply_rows(v->p, v->q, v->chunks.start[c], v->chunks.start[c + 1]);
+                          v->pq[c] = pcg_product(*A, v->p, v->q, v->chunks.start[c],
+                                                 v->chunks.start[c + 1]);
                       }),
-          part_kernel("vector updates and dot products", "pcg", updates, in.passes, [v] {
-            for (const int c : StaticShare(v->chunks.count())) {
-              const int first = v->chunks.first_dof(c), size = v->chunks.dofs(c);
-              v->y.segment(first, size) += 1e-3 * v->p.segment(first, size);
-              v->r.segment(first, size) -= 1e-3 * v->q.segment(first, size);
-              v->rr[c] = v->r.segment(first, size).squaredNorm();
-              v->rs[c] = v->r.segment(first, size).dot(v->s.segment(first, size));
-              v->p.segment(first, size) =
-                  v->s.segment(first, size) + 0.5 * v->p.segment(first, size);
-            }
+          part_kernel("update y, r and r . r", "pcg", update, in.passes,
+                      [v] {
+                        for (const int c : StaticShare(v->chunks.count()))
+                          v->rr[c] = pcg_update(1e-3, v->p, v->q, v->y, v->r, ChunkFilter{},
+                                                v->chunks.start[c], v->chunks.start[c + 1]);
+                      }),
+          part_kernel("next direction p = s + beta p", "pcg", next, in.passes, [v] {
+            for (const int c : StaticShare(v->chunks.count()))
+              pcg_next_direction(0.5, v->s, v->p, v->chunks.start[c], v->chunks.start[c + 1]);
           })};
 }
 
 std::vector<PartKernel> preconditioner_kernels(JacobiOnChunks& part, const ch08::KernelInput& in) {
   const auto v = pcg_vectors(in.A);
-  Preconditioner* jacobi = &part.pcg_preconditioner();
-  jacobi->prepare(in.A, v->chunks);  // outside a team: on this thread
+  JacobiOnChunks* jacobi = &part;
+  jacobi->prepare(in.A);  // outside a team: on this thread
   const PhaseWork inverses = ch07::block_jacobi(in.m);
   const PhaseWork work = ch01::phase_work(
       "block jacobi", in.m.vector_bytes + inverses.bytes_read, in.m.vector_bytes, in.m.vector_bytes,

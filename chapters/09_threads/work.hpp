@@ -21,8 +21,8 @@ ExecutedWork element_counters(const ThreadedElements& part, double elements);
 double team_size(const TeamOfThreads& team);
 
 // The PCG's own kernels alone, which its count takes as one part ("pcg", ch01::pcg_work): the
-// product q = A p and the vector updates of an iteration (x += a p, r -= a q, r . r, r . s,
-// p = s + b p), once per pass; and block Jacobi s = D^-1 r (the "preconditioner" part).
+// kernels its loops call (parallel_pcg.hpp), the product through the recipe's product part,
+// once per pass each; and block Jacobi s = D^-1 r (the "preconditioner" part).
 std::vector<PartKernel> solver_kernels(ParallelPcgSolver& part, const ch08::KernelInput& in);
 std::vector<PartKernel> preconditioner_kernels(JacobiOnChunks& part, const ch08::KernelInput& in);
 // A kernel of `part` (a part of the solve's count), run `calls` times a step.

@@ -184,17 +184,19 @@ FromZero from_zero(MultigridStepper& stepper, const Scene& scene, const SolverSe
   const Eigen::VectorXd& b = stepper.system_rhs();
   FromZero out;
   ch09::ParallelPcg pcg(A, scene.constraints);
-  const auto solve = [&](ch09::Preconditioner& M, SolveStats& stats, double& ms) {
+  const ch08::PartSetup setup{stepper.scene(), stepper.model(), stepper.system(),
+                              stepper.settings()};
+  ch08::AssembledProduct product(setup, {});
+  const auto solve = [&](ch08::PreconditionerPart& M, SolveStats& stats, double& ms) {
     Eigen::VectorXd y = Eigen::VectorXd::Zero(b.size());
-    stats = pcg.solve(A, M, b, solver, y);
+    stats = pcg.solve(A, product, M, b, solver, y);
     ms = time_ms(5, [&] {
       y.setZero();
-      pcg.solve(A, M, b, solver, y);
+      pcg.solve(A, product, M, b, solver, y);
     });
   };
-  VCyclePreconditioner v_cycle(stepper.preconditioner().multigrid());
-  solve(v_cycle, out.v_cycle, out.v_cycle_ms);
-  ch09::BlockJacobi block_jacobi(stepper.system().index.diagonal);
+  solve(stepper.preconditioner(), out.v_cycle, out.v_cycle_ms);
+  ch09::JacobiOnChunks block_jacobi(setup, {});
   solve(block_jacobi, out.jacobi, out.jacobi_ms);
   const Eigen::SparseMatrix<double> csc = A.to_sparse();
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper,

@@ -31,13 +31,12 @@ void check(const MultigridStepperSettings& settings) {
   check_extrapolation(settings.extrapolation);
 }
 
-void VCyclePreconditioner::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
+void MultigridPreconditioner::prepare(const ch07::BlockSparseMatrix& A) {
   // Every thread of the solve's team: the multigrid shares out its own row blocks.
   multigrid_.factorize(A.blocks);
 }
 
-void VCyclePreconditioner::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
-                                 Eigen::VectorXd& s) {
+void MultigridPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   // One V-cycle, on every thread of the team, ending with a barrier: the PCG then reads s on
   // any row. Filtered on both sides by the PCG, S M S is symmetric positive definite on the
   // free subspace, as PCG needs.

@@ -7,35 +7,23 @@
 #include <ostream>
 
 #include "chapters/08_element_kernels/step.hpp"
-#include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/10_multigrid/multigrid.hpp"
 
 namespace fem::ch10 {
 
-// One V-cycle of the hierarchy as the preconditioner of chapter 09's PCG: prepare() gives
-// the hierarchy this solve's matrix (factorize), apply() runs one cycle from a zero guess.
-class VCyclePreconditioner final : public ch09::Preconditioner {
- public:
-  explicit VCyclePreconditioner(Multigrid& multigrid) : multigrid_(multigrid) {}
-  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
-  bool block_diagonal() const override { return false; }
-  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
-
- private:
-  Multigrid& multigrid_;
-};
-
 // Preconditioner: the hierarchy, set up once from the mesh (analyze_pattern: aggregates,
 // rigid-body modes at the rest positions, patterns), its finest level refreshed every solve
-// and its coarse levels every few (factorize), one V-cycle per PCG iteration (apply).
-class MultigridPreconditioner {
+// and its coarse levels every few (factorize, in prepare), one V-cycle per PCG iteration from a
+// zero guess (apply).
+class MultigridPreconditioner final : public ch08::PreconditionerPart {
  public:
   using Params = MultigridSettings;  // check(params) throws std::invalid_argument
   static constexpr const char* kName = "one V-cycle of smoothed-aggregation multigrid";
   static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
 
   MultigridPreconditioner(const ch08::PartSetup& setup, const Params& params);
-  ch09::Preconditioner& pcg_preconditioner() { return v_cycle_; }
+  void prepare(const ch07::BlockSparseMatrix& A) override;
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
   Multigrid& multigrid() { return multigrid_; }
   const Multigrid& multigrid() const { return multigrid_; }
   // The hierarchy it built: per level its rows, blocks and bytes.
@@ -43,7 +31,6 @@ class MultigridPreconditioner {
 
  private:
   Multigrid multigrid_;
-  VCyclePreconditioner v_cycle_{multigrid_};
 };
 
 // Guess: the polynomial through the last order + 1 solutions, one step ahead.

@@ -17,13 +17,14 @@
 namespace fem::ch10 {
 
 struct MultigridRecipe {
-  using BuildsOn = ch09::Threads;  // the chapter this recipe changes
-  using Order = ch08::MeshOrder;                   // chapter 08's
-  using Team = ch09::TeamOfThreads;                // chapter 09's
-  using Elements = ch09::ThreadedElements;         // chapter 09's
-  using Guess = Extrapolation;                     // new: from the last three solutions
-  using Preconditioner = MultigridPreconditioner;  // new: one V-cycle
-  using Solver = ch09::ParallelPcgSolver;          // chapter 09's
+  using BuildsOn = ch09::Threads;
+  using Order = ch08::MeshOrder;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch09::ThreadedElements;
+  using Guess = ch10::Extrapolation;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch10::MultigridPreconditioner;
+  using Solver = ch09::ParallelPcgSolver;
 };
 
 using MultigridStepper = ch08::StepOf<MultigridRecipe>;

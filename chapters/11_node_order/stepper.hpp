@@ -15,13 +15,14 @@
 namespace fem::ch11 {
 
 struct NodeOrderRecipe {
-  using BuildsOn = ch10::MultigridRecipe;  // the chapter this recipe changes
-  using Order = RenumberedNodes;                         // new: reverse Cuthill-McKee
-  using Team = ch09::TeamOfThreads;                      // chapter 09's
-  using Elements = ch09::ThreadedElements;               // chapter 09's, in slabs
-  using Guess = ch10::Extrapolation;                     // chapter 10's
-  using Preconditioner = ch10::MultigridPreconditioner;  // chapter 10's
-  using Solver = ch09::ParallelPcgSolver;                // chapter 09's
+  using BuildsOn = ch10::MultigridRecipe;
+  using Order = ch11::RenumberedNodes;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch09::ThreadedElements;
+  using Guess = ch10::Extrapolation;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch10::MultigridPreconditioner;
+  using Solver = ch09::ParallelPcgSolver;
 };
 
 using NodeOrderStepper = ch08::StepOf<NodeOrderRecipe>;

@@ -57,10 +57,8 @@ struct Run {
 template <class S>
 std::unique_ptr<Stepper> made(std::unique_ptr<S> stepper, Run* timed) {
   if (timed) {
-    ch09::Preconditioner* M = &stepper->preconditioner().pcg_preconditioner();
-    timed->v_cycle = [M](const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-      M->apply(ch09::RowChunks{}, r, s);
-    };
+    ch08::PreconditionerPart* M = &stepper->preconditioner();
+    timed->v_cycle = [M](const Eigen::VectorXd& r, Eigen::VectorXd& s) { M->apply(r, s); };
     timed->rhs = &stepper->system_rhs();
     if constexpr (std::is_same_v<S, HalfBytesStepper>)
       timed->float_bytes = stepper->preconditioner().v_cycle().number_bytes();

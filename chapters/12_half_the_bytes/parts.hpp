@@ -40,7 +40,7 @@ class BatchedElementPass {
 // through a copy of its numbers in float: in float arithmetic (Real = float, Arithmetic::single)
 // or widened to double in registers (Real = double, Arithmetic::double_on_float).
 template <class Real>
-class ReducedMultigrid {
+class ReducedMultigrid final : public ch08::PreconditionerPart {
  public:
   using Params = ch10::MultigridSettings;
   static constexpr const char* kName = std::is_same_v<Real, float>
@@ -52,7 +52,9 @@ class ReducedMultigrid {
 
   ReducedMultigrid(const ch08::PartSetup& setup, const Params& params)
       : hierarchy_(setup, params), reduced_(hierarchy_.multigrid()) {}
-  ch09::Preconditioner& pcg_preconditioner() { return reduced_; }
+  // Chapter 10's factorize in double, then the new numbers into float; one cycle in Real.
+  void prepare(const ch07::BlockSparseMatrix& A) override { reduced_.prepare(A); }
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override { reduced_.apply(r, s); }
   ReducedVCycle<Real>& v_cycle() { return reduced_; }
   ch10::Multigrid& multigrid() { return hierarchy_.multigrid(); }
   const ch10::Multigrid& multigrid() const { return hierarchy_.multigrid(); }

@@ -73,7 +73,7 @@ void ReducedVCycle<Real>::convert(ReducedLevel<Real, B>& level, bool refreshed, 
 }
 
 template <class Real>
-void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks&) {
+void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A) {
   multigrid_.factorize(A.blocks);
   // Everything after a refresh, and the first time (a hierarchy factorized before this object
   // existed); read by every thread after factorize's last barrier, written after convert's.
@@ -84,8 +84,7 @@ void ReducedVCycle<Real>::prepare(const ch07::BlockSparseMatrix& A, const ch09::
 }
 
 template <class Real>
-void ReducedVCycle<Real>::apply(const ch09::RowChunks&, const Eigen::VectorXd& r,
-                                Eigen::VectorXd& s) {
+void ReducedVCycle<Real>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   if constexpr (std::is_same_v<Real, double>) {
     multigrid_.apply(fine_, coarse_, r, s);
   } else {

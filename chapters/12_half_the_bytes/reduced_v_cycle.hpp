@@ -20,7 +20,7 @@
 #include <atomic>
 #include <vector>
 
-#include "chapters/09_threads/parallel_pcg.hpp"
+#include "chapters/07_block_sparse/block_sparse.hpp"
 #include "chapters/10_multigrid/multigrid.hpp"
 
 namespace fem::ch12 {
@@ -54,7 +54,7 @@ const ch10::Level<B>& source_level(const ReducedLevel<Real, B>& level) {
 enum class Arithmetic { single, double_on_float };
 
 template <class Real>
-class ReducedVCycle final : public ch09::Preconditioner {
+class ReducedVCycle {
  public:
   using Vector = Eigen::Matrix<Real, Eigen::Dynamic, 1>;
 
@@ -63,10 +63,9 @@ class ReducedVCycle final : public ch09::Preconditioner {
   explicit ReducedVCycle(ch10::Multigrid& multigrid);
 
   // Chapter 10's factorize in double, then its new numbers into float. By every thread.
-  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
-  bool block_diagonal() const override { return false; }
+  void prepare(const ch07::BlockSparseMatrix& A);
   // s = M r, one V-cycle in Real arithmetic on the float numbers. By every thread.
-  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // The bytes one V-cycle's numbers occupy: blocks, prolongators (P and R) and inverse
   // diagonals of every level; chapter 10's in double are twice as many.

@@ -15,13 +15,14 @@
 namespace fem::ch12 {
 
 struct HalfTheBytes {
-  using BuildsOn = ch11::NodeOrderRecipe;  // the chapter this recipe changes
-  using Order = ch11::RenumberedNodes;             // chapter 11's
-  using Team = ch09::TeamOfThreads;                // chapter 09's
-  using Elements = BatchedElementPass;             // new: one element per lane
-  using Guess = ch10::Extrapolation;               // chapter 10's
-  using Preconditioner = ReducedMultigrid<float>;  // new: the V-cycle in float
-  using Solver = ch09::ParallelPcgSolver;          // chapter 09's
+  using BuildsOn = ch11::NodeOrderRecipe;
+  using Order = ch11::RenumberedNodes;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch12::BatchedElementPass;
+  using Guess = ch10::Extrapolation;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch12::ReducedMultigrid<float>;
+  using Solver = ch09::ParallelPcgSolver;
 };
 
 using HalfBytesStepper = ch08::StepOf<HalfTheBytes>;

@@ -17,8 +17,8 @@ FusedVCycle::FusedVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& m
   s_.setZero(dofs);
 }
 
-void FusedVCycle::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) {
-  reduced_.prepare(A, chunks);  // the hierarchy's numbers, then their float copies
+void FusedVCycle::prepare(const ch07::BlockSparseMatrix& A) {
+  reduced_.prepare(A);  // the hierarchy's numbers, then their float copies
 }
 
 bool FusedVCycle::fused() const {
@@ -41,10 +41,9 @@ void FusedVCycle::complete(Eigen::VectorXd& s, const RowsCall& finish) {
   });
 }
 
-void FusedVCycle::apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r,
-                        Eigen::VectorXd& s) {
+void FusedVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   if (!fused()) {  // one level, or one thread: nothing to fuse
-    reduced_.apply(chunks, r, s);
+    reduced_.apply(r, s);
     return;
   }
   ch09::for_parts(fine_part(), true, [&](int first, int last) { enter(first, last, r); });

@@ -109,15 +109,14 @@ class RowsCall {
 // The float V-cycle of the hierarchy as the PCG's preconditioner, run by fused_cycle: the same
 // numbers (the float levels that `reduced` converts in prepare), the same result, four waits
 // fewer per cycle on a three-level hierarchy (fused_v_cycle.cpp counts them).
-class FusedVCycle final : public ch09::Preconditioner {
+class FusedVCycle {
  public:
   // `reduced` (its levels and its conversion) and the hierarchy it reads must outlive this.
   FusedVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& multigrid);
-  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
-  bool block_diagonal() const override { return false; }
+  void prepare(const ch07::BlockSparseMatrix& A);
   // s = M r: r into float inside the finest level's first step, s back to double inside its
   // last. By every thread of the PCG's team.
-  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // The same cycle in two parts, for a solver that runs the first inside a loop of its own:
   // enter(first, last, r) on every row block of fine_part() as r's rows are written, then

@@ -33,32 +33,26 @@ double SingleReductionPcg::sum(const std::vector<double>& partial) const {
   return total;
 }
 
-void SingleReductionPcg::filter(int p, Eigen::VectorXd& v) const {
-  for (int k = constraint_start_[p]; k < constraint_start_[p + 1]; ++k) {
-    const NodeConstraint& c = constraints_[k];
-    v.segment<3>(3 * c.node) = c.filter * v.segment<3>(3 * c.node);
-  }
-}
-
-SolveStats SingleReductionPcg::solve(const ch07::BlockSparseMatrix& A, FusedVCycle& M,
-                                     const Eigen::VectorXd& b, const SolverSettings& settings,
-                                     Eigen::VectorXd& y) {
+SolveStats SingleReductionPcg::solve(const ch07::BlockSparseMatrix& A, ch08::ProductPart& product,
+                                     FusedVCycle& M, const Eigen::VectorXd& b,
+                                     const SolverSettings& settings, Eigen::VectorXd& y) {
   for (Eigen::VectorXd* v : {&r_, &s_, &w_, &p_, &q_}) v->resize(b.size());  // allocates once
   SolveStats result;
   ch09::run_parallel([&] {
-    M.prepare(A, ch09::RowChunks{});  // the hierarchy shares out its own row blocks
-    const double rhs_norm2 = start(A, M, b, y);
-    const SolveStats stats = iterate(A, M, rhs_norm2, settings, y);
+    product.prepare(A);
+    M.prepare(A);  // the hierarchy shares out its own row blocks
+    const double rhs_norm2 = start(product, M, b, y);
+    const SolveStats stats = iterate(product, M, rhs_norm2, settings, y);
 #pragma omp master
     result = stats;
   });
   return result;
 }
 
-double SingleReductionPcg::start(const ch07::BlockSparseMatrix& A, FusedVCycle& M,
+double SingleReductionPcg::start(const ch08::ProductPart& A, FusedVCycle& M,
                                  const Eigen::VectorXd& b, Eigen::VectorXd& y) {
   for (const int p : ch09::StaticShare(static_cast<int>(part_.size()) - 1)) {
-    filter(p, y);
+    filter(p)(y);
     const int first = 3 * part_[p], size = 3 * (part_[p + 1] - part_[p]);
     partial_bb_[p] = b.segment(first, size).squaredNorm();
   }
@@ -67,16 +61,15 @@ double SingleReductionPcg::start(const ch07::BlockSparseMatrix& A, FusedVCycle& 
     const int first = 3 * part_[p], size = 3 * (part_[p + 1] - part_[p]);
     A.multiply_rows(y, w_, part_[p], part_[p + 1]);
     r_.segment(first, size) = b.segment(first, size) - w_.segment(first, size);
-    filter(p, r_);
+    filter(p)(r_);
     partial_rr_[p] = r_.segment(first, size).squaredNorm();
     M.enter(part_[p], part_[p + 1], r_);
   }
   return sum(partial_bb_);
 }
 
-SolveStats SingleReductionPcg::iterate(const ch07::BlockSparseMatrix& A, FusedVCycle& M,
-                                       double rhs_norm2, const SolverSettings& settings,
-                                       Eigen::VectorXd& y) {
+SolveStats SingleReductionPcg::iterate(const ch08::ProductPart& A, FusedVCycle& M, double rhs_norm2,
+                                       const SolverSettings& settings, Eigen::VectorXd& y) {
   SolveStats stats;
   if (rhs_norm2 == 0.0) {  // as Eigen: the solution of A y = 0 is 0
     for (const int p : ch09::StaticShare(static_cast<int>(part_.size()) - 1))
@@ -107,23 +100,20 @@ SolveStats SingleReductionPcg::iterate(const ch07::BlockSparseMatrix& A, FusedVC
   return stats;
 }
 
-SingleReductionPcg::Sums SingleReductionPcg::precondition_and_product(
-    const ch07::BlockSparseMatrix& A, FusedVCycle& M) {
+SingleReductionPcg::Sums SingleReductionPcg::precondition_and_product(const ch08::ProductPart& A,
+                                                                      FusedVCycle& M) {
   // s = S M r; gamma's parts as each thread's last smoothing step writes its rows of s.
   const auto finish = [&](int first, int last) {
     const int p = static_cast<int>(std::lower_bound(part_.begin(), part_.end(), first) -
                                    part_.begin());  // the row block that starts at first
-    filter(p, s_);
+    filter(p)(s_);
     const int f = 3 * first, size = 3 * (last - first);
     partial_gamma_[p] = r_.segment(f, size).dot(s_.segment(f, size));
   };
   M.complete(s_, finish);
   // w = A s reads s's neighbours: after the cycle's last barrier.
-  for (const int p : ch09::StaticShare(static_cast<int>(part_.size()) - 1)) {
-    const int first = 3 * part_[p], size = 3 * (part_[p + 1] - part_[p]);
-    A.multiply_rows(s_, w_, part_[p], part_[p + 1]);
-    partial_delta_[p] = s_.segment(first, size).dot(w_.segment(first, size));
-  }
+  for (const int p : ch09::StaticShare(static_cast<int>(part_.size()) - 1))
+    partial_delta_[p] = single_reduction_product(A, s_, w_, part_[p], part_[p + 1]);
   return {0.0, sum(partial_gamma_), sum(partial_delta_)};
 }
 
@@ -131,21 +121,36 @@ double SingleReductionPcg::update(FusedVCycle& M, double alpha, double beta, Eig
   // Row-local work only: the recurrences, the new residual and the next cycle's first step
   // on it (wasted on the last iteration, which nobody knows is the last until ||r|| is summed).
   for (const int p : ch09::StaticShare(static_cast<int>(part_.size()) - 1)) {
-    const int first = 3 * part_[p], size = 3 * (part_[p + 1] - part_[p]);
-    if (beta == 0.0) {
-      p_.segment(first, size) = s_.segment(first, size);
-      q_.segment(first, size) = w_.segment(first, size);
-    } else {
-      p_.segment(first, size) = s_.segment(first, size) + beta * p_.segment(first, size);
-      q_.segment(first, size) = w_.segment(first, size) + beta * q_.segment(first, size);
-    }
-    y.segment(first, size) += alpha * p_.segment(first, size);
-    r_.segment(first, size) -= alpha * q_.segment(first, size);
-    filter(p, r_);
-    partial_rr_[p] = r_.segment(first, size).squaredNorm();
+    partial_rr_[p] = single_reduction_update(alpha, beta, s_, w_, p_, q_, y, r_, filter(p),
+                                             part_[p], part_[p + 1]);
     M.enter(part_[p], part_[p + 1], r_);
   }
   return sum(partial_rr_);
+}
+
+double single_reduction_product(const ch08::ProductPart& A, const Eigen::VectorXd& s,
+                                Eigen::VectorXd& w, int first, int last) {
+  A.multiply_rows(s, w, first, last);
+  const int f = 3 * first, size = 3 * (last - first);
+  return s.segment(f, size).dot(w.segment(f, size));
+}
+
+double single_reduction_update(double alpha, double beta, const Eigen::VectorXd& s,
+                               const Eigen::VectorXd& w, Eigen::VectorXd& p, Eigen::VectorXd& q,
+                               Eigen::VectorXd& y, Eigen::VectorXd& r,
+                               const ch09::ChunkFilter& filter, int first, int last) {
+  const int f = 3 * first, size = 3 * (last - first);
+  if (beta == 0.0) {
+    p.segment(f, size) = s.segment(f, size);
+    q.segment(f, size) = w.segment(f, size);
+  } else {
+    p.segment(f, size) = s.segment(f, size) + beta * p.segment(f, size);
+    q.segment(f, size) = w.segment(f, size) + beta * q.segment(f, size);
+  }
+  y.segment(f, size) += alpha * p.segment(f, size);
+  r.segment(f, size) -= alpha * q.segment(f, size);
+  filter(r);
+  return r.segment(f, size).squaredNorm();
 }
 
 }  // namespace fem::ch13

@@ -13,11 +13,23 @@
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/08_element_kernels/contract.hpp"
 #include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/13_fewer_waits/fused_v_cycle.hpp"
 #include "common/stepper.hpp"
 
 namespace fem::ch13 {
+
+// Its kernels on the rows [first, last) of one row block, each returning the block's part of the
+// sum it ends with: the solver's loops call them, and so does the roofline's kernels alone.
+//   w = A s; s . w
+double single_reduction_product(const ch08::ProductPart& A, const Eigen::VectorXd& s,
+                                Eigen::VectorXd& w, int first, int last);
+//   p = s + beta p, q = w + beta q, y += alpha p, r -= alpha q, r filtered; r . r
+double single_reduction_update(double alpha, double beta, const Eigen::VectorXd& s,
+                               const Eigen::VectorXd& w, Eigen::VectorXd& p, Eigen::VectorXd& q,
+                               Eigen::VectorXd& y, Eigen::VectorXd& r,
+                               const ch09::ChunkFilter& filter, int first, int last);
 
 class SingleReductionPcg {
  public:
@@ -27,20 +39,23 @@ class SingleReductionPcg {
   void set_constraints(const std::vector<NodeConstraint>& constraints);
   // y holds the initial guess on entry and the solution on exit; the same stopping rule and
   // PPCG filter as chapter 09's PCG. M must be fused() (FusedVCycle).
-  SolveStats solve(const ch07::BlockSparseMatrix& A, FusedVCycle& M, const Eigen::VectorXd& b,
-                   const SolverSettings& settings, Eigen::VectorXd& y);
+  SolveStats solve(const ch07::BlockSparseMatrix& A, ch08::ProductPart& product, FusedVCycle& M,
+                   const Eigen::VectorXd& b, const SolverSettings& settings, Eigen::VectorXd& y);
 
  private:
   struct Sums {  // this iteration's sums, the same on every thread
     double rr = 0.0, gamma = 0.0, delta = 0.0;
   };
-  SolveStats iterate(const ch07::BlockSparseMatrix& A, FusedVCycle& M, double rhs_norm2,
+  SolveStats iterate(const ch08::ProductPart& A, FusedVCycle& M, double rhs_norm2,
                      const SolverSettings& settings, Eigen::VectorXd& y);
-  double start(const ch07::BlockSparseMatrix& A, FusedVCycle& M, const Eigen::VectorXd& b,
+  double start(const ch08::ProductPart& A, FusedVCycle& M, const Eigen::VectorXd& b,
                Eigen::VectorXd& y);  // r = S (b - A y), M's first step; ||b||^2
-  Sums precondition_and_product(const ch07::BlockSparseMatrix& A, FusedVCycle& M);  // s, w
-  double update(FusedVCycle& M, double alpha, double beta, Eigen::VectorXd& y);     // ||r||^2
-  void filter(int p, Eigen::VectorXd& v) const;  // the PPCG projection on part p's nodes
+  Sums precondition_and_product(const ch08::ProductPart& A, FusedVCycle& M);     // s, w
+  double update(FusedVCycle& M, double alpha, double beta, Eigen::VectorXd& y);  // ||r||^2
+  ch09::ChunkFilter filter(int p) const {  // the PPCG projection on part p's nodes
+    return {constraints_.data() + constraint_start_[p],
+            constraints_.data() + constraint_start_[p + 1]};
+  }
   double sum(const std::vector<double>& partial) const;
 
   std::vector<int> part_;

@@ -15,13 +15,14 @@
 namespace fem::ch13 {
 
 struct FewerWaits {
-  using BuildsOn = ch12::HalfTheBytes;  // the chapter this recipe changes
-  using Order = ch11::RenumberedNodes;         // chapter 11's
-  using Team = ch09::TeamOfThreads;            // chapter 09's
-  using Elements = ch12::BatchedElementPass;   // chapter 12's
-  using Guess = ch10::Extrapolation;           // chapter 10's
-  using Preconditioner = FusedPreconditioner;  // new: chapter 12's cycle in fused loops
-  using Solver = SingleReductionSolver;        // new: one wait per reduction
+  using BuildsOn = ch12::HalfTheBytes;
+  using Order = ch11::RenumberedNodes;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch12::BatchedElementPass;
+  using Guess = ch10::Extrapolation;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch13::FusedPreconditioner;
+  using Solver = ch13::SingleReductionSolver;
 };
 
 using FewerWaitsStepper = ch08::StepOf<FewerWaits>;

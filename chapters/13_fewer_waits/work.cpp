@@ -20,10 +20,9 @@ PhaseWork solver_work(const SingleReductionSolver&, const ch08::WorkInput& in,
   // the product w = A s (the matrix and s read, w written fresh) with delta = s . w; the update
   // loop reads s, p, w, q, y and r and writes p, q, y and r back, with ||r||^2.
   const ch01::MeshSizes& m = in.m;
-  const double v = m.vector_bytes, matrix = ch07::matrix_bytes(in.A);
-  const double entries = 9.0 * double(in.A.blocks.size());
-  const PhaseWork own =
-      ch01::phase_work("pcg", matrix + 8 * v, 5 * v, v, 2 * entries + 14 * m.dofs, matrix + 6 * v);
+  const double v = m.vector_bytes, matrix = in.product.matrix_bytes;
+  const PhaseWork own = ch01::phase_work("pcg", matrix + 8 * v, 5 * v, v,
+                                         in.product.flops + 14 * m.dofs, matrix + 6 * v);
   return ch08::solve_work(in, own, preconditioner);
 }
 
@@ -33,7 +32,7 @@ namespace {
 struct IterationVectors {
   ch09::RowChunks chunks;
   Eigen::VectorXd y, r, s, w, p, q;
-  std::vector<double> rr, gamma, delta;
+  std::vector<double> rr, delta;
 };
 
 std::shared_ptr<IterationVectors> iteration_vectors(const ch07::BlockSparseMatrix& A) {
@@ -44,7 +43,6 @@ std::shared_ptr<IterationVectors> iteration_vectors(const ch07::BlockSparseMatri
   for (Eigen::VectorXd* x : {&v->y, &v->r, &v->s, &v->w, &v->p, &v->q})
     *x = Eigen::VectorXd::LinSpaced(n, 1e-3, 1.0);
   v->rr.assign(v->chunks.count(), 0.0);
-  v->gamma.assign(v->chunks.count(), 0.0);
   v->delta.assign(v->chunks.count(), 0.0);
   return v;
 }
@@ -52,36 +50,27 @@ std::shared_ptr<IterationVectors> iteration_vectors(const ch07::BlockSparseMatri
 }  // namespace
 
 std::vector<PartKernel> solver_kernels(SingleReductionSolver&, const ch08::KernelInput& in) {
-  const ch07::BlockSparseMatrix& A = in.A;
-  const auto v = iteration_vectors(A);
+  const auto v = iteration_vectors(in.A);
   const double vector = 8.0 * double(v->s.size()), dofs = double(v->s.size());
-  const double matrix = ch07::matrix_bytes(A), entries = 9.0 * double(A.blocks.size());
-  // gamma = r . s, which the cycle's last loop sums as it writes s, with the product here.
-  const PhaseWork product = ch01::phase_work("product", matrix + 2 * vector, vector, vector,
-                                             2 * entries + 4 * dofs, matrix + 3 * vector);
+  const double matrix = in.product_work.matrix_bytes;
+  const PhaseWork product = ch01::phase_work("product", matrix + vector, vector, vector,
+                                             in.product_work.flops + 2 * dofs, matrix + 2 * vector);
   const PhaseWork updates =
       ch01::phase_work("updates", 6 * vector, 4 * vector, 0.0, 10 * dofs, 6 * vector);
+  const ch08::ProductPart* A = &in.product;
   using ch09::StaticShare;
-  return {
-      ch09::part_kernel("product w = A s, r . s and s . w", "pcg", product, in.passes,
-                        [v, &A] {
-                          for (const int c : StaticShare(v->chunks.count())) {
-                            const int first = v->chunks.first_dof(c), size = v->chunks.dofs(c);
-                            A.multiply_rows(v->s, v->w, v->chunks.start[c], v->chunks.start[c + 1]);
-                            v->gamma[c] = v->r.segment(first, size).dot(v->s.segment(first, size));
-                            v->delta[c] = v->s.segment(first, size).dot(v->w.segment(first, size));
-                          }
-                        }),
-      ch09::part_kernel("recurrences and r . r", "pcg", updates, in.passes, [v] {
-        for (const int c : StaticShare(v->chunks.count())) {
-          const int first = v->chunks.first_dof(c), size = v->chunks.dofs(c);
-          v->p.segment(first, size) = v->s.segment(first, size) + 0.5 * v->p.segment(first, size);
-          v->q.segment(first, size) = v->w.segment(first, size) + 0.5 * v->q.segment(first, size);
-          v->y.segment(first, size) += 1e-3 * v->p.segment(first, size);
-          v->r.segment(first, size) -= 1e-3 * v->q.segment(first, size);
-          v->rr[c] = v->r.segment(first, size).squaredNorm();
-        }
-      })};
+  return {ch09::part_kernel("product w = A s and s . w", "pcg", product, in.passes,
+                            [v, A] {
+                              for (const int c : StaticShare(v->chunks.count()))
+                                v->delta[c] = single_reduction_product(
+                                    *A, v->s, v->w, v->chunks.start[c], v->chunks.start[c + 1]);
+                            }),
+          ch09::part_kernel("recurrences and r . r", "pcg", updates, in.passes, [v] {
+            for (const int c : StaticShare(v->chunks.count()))
+              v->rr[c] = single_reduction_update(1e-3, 0.5, v->s, v->w, v->p, v->q, v->y, v->r,
+                                                 ch09::ChunkFilter{}, v->chunks.start[c],
+                                                 v->chunks.start[c + 1]);
+          })};
 }
 
 std::vector<PartKernel> preconditioner_kernels(FusedPreconditioner& part,

@@ -16,9 +16,10 @@ ch08::PreconditionerWork preconditioner_work(const FusedPreconditioner& part,
 PhaseWork solver_work(const SingleReductionSolver& part, const ch08::WorkInput& in,
                       const ch08::PreconditionerWork& preconditioner);
 
-// Its own kernels alone (single_reduction_pcg.cpp's loops on the row chunks): w = A s with
-// delta = s . w, and the update p = s + b p, q = w + b q, y += a p, r -= a q with r . r; and
-// the fused cycle's fine smoothing step, chapter 12's.
+// Its own kernels alone, the ones its loops call (single_reduction_pcg.hpp), on the row chunks:
+// w = A s with delta = s . w through the recipe's product part, and the update p = s + b p,
+// q = w + b q, y += a p, r -= a q with r . r; and the fused cycle's fine smoothing step,
+// chapter 12's.
 std::vector<PartKernel> solver_kernels(SingleReductionSolver& part, const ch08::KernelInput& in);
 std::vector<PartKernel> preconditioner_kernels(FusedPreconditioner& part,
                                                const ch08::KernelInput& in);

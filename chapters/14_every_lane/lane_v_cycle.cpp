@@ -25,8 +25,8 @@ LaneVCycle::LaneVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& mul
       r_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())),
       s_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())) {}
 
-void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) {
-  reduced_.prepare(A, chunks);
+void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A) {
+  reduced_.prepare(A);
   if (!lanes_) return;
   // Each thread fills the row blocks it smooths (the same static share of the same parts).
   with_fine_level([](auto& fine) {
@@ -35,10 +35,9 @@ void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks
   });
 }
 
-void LaneVCycle::apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r,
-                       Eigen::VectorXd& s) {
+void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   if (!lanes_) {
-    reduced_.apply(chunks, r, s);
+    reduced_.apply(r, s);
     return;
   }
   const std::vector<int>& part = reduced_.fine_level().source->rows.part;

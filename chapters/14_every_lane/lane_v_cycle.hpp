@@ -28,7 +28,7 @@ namespace fem::ch14 {
 using InCacheLanes = LaneFineLevel;
 using FromMemoryLanes = PackedFineLevel;
 
-class LaneVCycle final : public ch09::Preconditioner {
+class LaneVCycle {
  public:
   // Both must outlive this object; `reduced` reads `multigrid`'s levels. The finest level is
   // padded when a smoothing step's data fit in `cache_bytes` (by default the last cache the
@@ -38,10 +38,9 @@ class LaneVCycle final : public ch09::Preconditioner {
 
   // Chapter 12's prepare (chapter 10's factorize, its numbers into float), then the finest
   // level's double blocks into the lanes. By every thread.
-  void prepare(const ch07::BlockSparseMatrix& A, const ch09::RowChunks& chunks) override;
-  bool block_diagonal() const override { return false; }
+  void prepare(const ch07::BlockSparseMatrix& A);
   // s = M r: one float V-cycle from the lanes' finest level. By every thread.
-  void apply(const ch09::RowChunks& chunks, const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // A hierarchy of one level is its coarsest, solved by chapter 10's Cholesky factor: no lanes.
   bool lanes() const { return lanes_; }

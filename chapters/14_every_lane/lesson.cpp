@@ -73,9 +73,9 @@ void v_cycle_rows(EveryLaneStepper& stepper, int threads_max, int repeat, std::o
   Eigen::VectorXd s(r.size());
   for (int threads = 1; threads <= threads_max; ++threads) {
     const double old_us = us_per_call(
-        threads, [&] { reduced.apply(ch09::RowChunks{}, r, s); }, repeat);
+        threads, [&] { reduced.apply(r, s); }, repeat);
     const double new_us = us_per_call(
-        threads, [&] { part.lane_v_cycle().apply(ch09::RowChunks{}, r, s); }, repeat);
+        threads, [&] { part.lane_v_cycle().apply(r, s); }, repeat);
     out << "| one V-cycle (" << ch10::smoother_products(part.multigrid()) << " fine products) | "
         << threads << " | " << std::setprecision(1) << old_us << " | " << new_us << " | x"
         << std::setprecision(2) << old_us / new_us << " | | | | | | |\n";

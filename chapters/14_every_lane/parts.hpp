@@ -13,7 +13,7 @@
 namespace fem::ch14 {
 
 // Preconditioner: chapter 12's hierarchy in float, its finest level's products in pair lanes.
-class LaneMultigrid {
+class LaneMultigrid final : public ch08::PreconditionerPart {
  public:
   using Params = ch10::MultigridSettings;
   static constexpr const char* kName =
@@ -22,7 +22,8 @@ class LaneMultigrid {
 
   LaneMultigrid(const ch08::PartSetup& setup, const Params& params)
       : reduced_(setup, params), lanes_(reduced_.v_cycle(), reduced_.multigrid()) {}
-  ch09::Preconditioner& pcg_preconditioner() { return lanes_; }
+  void prepare(const ch07::BlockSparseMatrix& A) override { lanes_.prepare(A); }
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override { lanes_.apply(r, s); }
   LaneVCycle& lane_v_cycle() { return lanes_; }
   const LaneVCycle& lane_v_cycle() const { return lanes_; }
   ch12::ReducedMultigrid<float>& reduced() { return reduced_; }

@@ -16,13 +16,14 @@
 namespace fem::ch14 {
 
 struct EveryLane {
-  using BuildsOn = ch12::HalfTheBytes;  // the chapter this recipe changes
-  using Order = ch11::RenumberedNodes;     // chapter 11's
-  using Team = ch09::TeamOfThreads;        // chapter 09's
-  using Elements = LaneScatterPass;        // new: chapter 12's batches, scattered in lanes
-  using Guess = ch10::Extrapolation;       // chapter 10's
-  using Preconditioner = LaneMultigrid;    // new: the finest level in pair lanes
-  using Solver = ch09::ParallelPcgSolver;  // chapter 09's
+  using BuildsOn = ch12::HalfTheBytes;
+  using Order = ch11::RenumberedNodes;
+  using Team = ch09::TeamOfThreads;
+  using Elements = ch14::LaneScatterPass;
+  using Guess = ch10::Extrapolation;
+  using Product = ch08::AssembledProduct;
+  using Preconditioner = ch14::LaneMultigrid;
+  using Solver = ch09::ParallelPcgSolver;
 };
 
 using EveryLaneStepper = ch08::StepOf<EveryLane>;

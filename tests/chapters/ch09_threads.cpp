@@ -92,9 +92,12 @@ TEST_CASE("ch09: the parallel PCG solves the system to the tolerance, on any thr
   for (const int threads : thread_counts()) {
     const ThreadCountScope scope(threads);
     ch09::ParallelPcg pcg(A, scene.constraints);
-    ch09::BlockJacobi block_jacobi(stepper.system().index.diagonal);
+    const ch08::PartSetup setup{stepper.scene(), stepper.model(), stepper.system(),
+                                stepper.settings()};
+    ch08::AssembledProduct product(setup, {});
+    ch09::JacobiOnChunks block_jacobi(setup, {});
     Eigen::VectorXd y = Eigen::VectorXd::Zero(b.size()), Ay(b.size());
-    const SolveStats result = pcg.solve(A, block_jacobi, b, test::tight_solver(), y);
+    const SolveStats result = pcg.solve(A, product, block_jacobi, b, test::tight_solver(), y);
     A.multiply(y, Ay);
     INFO(threads << " threads: " << result.iterations << " iterations");
     CHECK(result.converged);

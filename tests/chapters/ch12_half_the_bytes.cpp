@@ -54,15 +54,15 @@ std::pair<double, double> asymmetry_and_positivity(const Scene& scene) {
   for (int k = 0; k < 3; ++k) stepper.step(state);
   REQUIRE(stepper.preconditioner().multigrid().levels() == 3);
   ch12::ReducedVCycle<Real> v_cycle(stepper.preconditioner().multigrid());
-  v_cycle.prepare(stepper.system_matrix(), ch09::RowChunks{});
+  v_cycle.prepare(stepper.system_matrix());
   std::srand(12);
   const Eigen::Index n = stepper.system_rhs().size();
   Eigen::VectorXd Mx(n), My(n);
   double asymmetry = 0.0, positivity = INFINITY;
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::VectorXd x = filtered_random(scene, n), y = filtered_random(scene, n);
-    v_cycle.apply(ch09::RowChunks{}, x, Mx);
-    v_cycle.apply(ch09::RowChunks{}, y, My);
+    v_cycle.apply(x, Mx);
+    v_cycle.apply(y, My);
     asymmetry =
         std::max(asymmetry, std::abs(x.dot(My) - y.dot(Mx)) / std::sqrt(x.dot(Mx) * y.dot(My)));
     positivity = std::min({positivity, x.dot(Mx) / x.squaredNorm(), y.dot(My) / y.squaredNorm()});
@@ -96,8 +96,8 @@ TEST_CASE("ch12: the float numbers are chapter 10's rounded, and half their byte
   stepper.step(state);
   ch12::ReducedVCycle<float> single(stepper.preconditioner().multigrid());
   ch12::ReducedVCycle<double> widened(stepper.preconditioner().multigrid());
-  single.prepare(stepper.system_matrix(), ch09::RowChunks{});
-  widened.prepare(stepper.system_matrix(), ch09::RowChunks{});
+  single.prepare(stepper.system_matrix());
+  widened.prepare(stepper.system_matrix());
   CHECK(single.number_bytes() == widened.number_bytes());
   // Chapter 10's hierarchy in double: blocks, prolongators both ways, inverse diagonals.
   const ch10::Multigrid& mg = stepper.preconditioner().multigrid();

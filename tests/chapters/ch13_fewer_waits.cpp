@@ -60,9 +60,9 @@ double fused_against_chapter_12(const Scene& scene, int threads,
     Eigen::VectorXd r(n), s12(n), s13(n);
     for (Eigen::Index k = 0; k < n; ++k) r[k] = uniform(rng);
     ch09::run_parallel([&] {
-      fused.prepare(stepper.system_matrix(), ch09::RowChunks{});
-      reduced.apply(ch09::RowChunks{}, r, s12);
-      fused.apply(ch09::RowChunks{}, r, s13);
+      fused.prepare(stepper.system_matrix());
+      reduced.apply(r, s12);
+      fused.apply(r, s13);
     });
     worst = std::max(worst, (s12 - s13).cwiseAbs().maxCoeff());
     if (!s13.allFinite()) worst = INFINITY;
@@ -168,11 +168,11 @@ TEST_CASE("ch13: the waits counted, per V-cycle and per PCG iteration, against c
   ch13::FusedVCycle fused(reduced, stepper.preconditioner().multigrid());
   const Eigen::VectorXd r = Eigen::VectorXd::Ones(stepper.system_rhs().size());
   Eigen::VectorXd s(r.size());
-  ch09::run_parallel([&] { fused.prepare(stepper.system_matrix(), ch09::RowChunks{}); });
+  ch09::run_parallel([&] { fused.prepare(stepper.system_matrix()); });
   const long long twelve =
-      barriers_during([&] { ch09::run_parallel([&] { reduced.apply({}, r, s); }); });
+      barriers_during([&] { ch09::run_parallel([&] { reduced.apply(r, s); }); });
   const long long thirteen =
-      barriers_during([&] { ch09::run_parallel([&] { fused.apply({}, r, s); }); });
+      barriers_during([&] { ch09::run_parallel([&] { fused.apply(r, s); }); });
   const int steps = ch10::smoothing_steps(reduced.fine_level());
   REQUIRE(steps == 3);  // chapter 10's default: Chebyshev of degree 3, one sweep
   INFO("per V-cycle: chapter 12 " << twelve << " waits, chapter 13 " << thirteen);

@@ -50,9 +50,9 @@ Applied apply_both(const Scene& scene, int threads, long long cache_bytes) {
   for (Eigen::Index k = 0; k < n; ++k) r[k] = uniform(rng);
   Applied out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
   ch09::run_parallel([&] {
-    lanes.prepare(stepper.system_matrix(), ch09::RowChunks{});
-    reduced.apply(ch09::RowChunks{}, r, out.twelve);
-    lanes.apply(ch09::RowChunks{}, r, out.lanes);
+    lanes.prepare(stepper.system_matrix());
+    reduced.apply(r, out.twelve);
+    lanes.apply(r, out.lanes);
   });
   return out;
 }
@@ -125,8 +125,8 @@ TEST_CASE("ch14: the roofline's count of the cycle reads the lanes' bytes, chapt
   fourteen.step(b);
   const ch01::MeshSizes m = ch01::mesh_sizes(scene);
   const WorkCounts counts{};
-  const ch08::WorkInput in12{m, twelve.system_matrix(), scene, counts};
-  const ch08::WorkInput in14{m, fourteen.system_matrix(), scene, counts};
+  const ch08::WorkInput in12{m, twelve.system_matrix(), scene, counts, {}};
+  const ch08::WorkInput in14{m, fourteen.system_matrix(), scene, counts, {}};
   const ch08::PreconditionerWork w12 = preconditioner_work(twelve.preconditioner(), in12);
   const ch08::PreconditionerWork w14 = preconditioner_work(fourteen.preconditioner(), in14);
   const ch14::LaneVCycle& cycle = fourteen.preconditioner().lane_v_cycle();
