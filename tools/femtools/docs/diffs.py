@@ -42,16 +42,19 @@ def chapter_dirs(root):
 
 
 def names(chapter):
-    """What is renamed from chapter to chapter: namespace, stepper class, id, number."""
-    match = STEPPER_CLASS.search((chapter / "stepper.hpp").read_text())
-    namespace = re.search(r"namespace fem::(\w+) \{", (chapter / "stepper.hpp").read_text())
+    """What is renamed from chapter to chapter: namespace, stepper class, recipe, id, number."""
+    text = (chapter / "stepper.hpp").read_text()
+    match = STEPPER_CLASS.search(text)
+    namespace = re.search(r"namespace fem::(\w+) \{", text)
+    recipe = re.search(r"StepOf<(\w+)>", text)
     return {"id": chapter.name, "number": chapter.name[:2],
             "namespace": namespace.group(1) if namespace else "",
-            "class": (match.group(1) or match.group(2)) if match else ""}
+            "class": (match.group(1) or match.group(2)) if match else "",
+            "recipe": recipe.group(1) if recipe else ""}
 
 
 def renamed(text, old, new, files=()):
-    """text of chapter `old` with the code names of chapter `new`, which copied `files` from
+    """text of chapter `old` with the code names of chapter `new` (namespace, stepper, recipe), which copied `files` from
     it; the words stay the old text's ("Chapter NN" is not renamed)."""
     # Its stepper.hpp (the registry's file) and the files the new chapter copied, under the new
     # chapter's path.
@@ -60,8 +63,9 @@ def renamed(text, old, new, files=()):
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
     if old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
-    if old["class"] and new["class"]:
-        text = re.sub(rf"\b{old['class']}\b", new["class"], text)
+    for name in ("class", "recipe"):
+        if old[name] and new[name]:
+            text = re.sub(rf"\b{old[name]}\b", new[name], text)
     return text
 
 
