@@ -15,6 +15,7 @@
 #include "apps/frame_times/lesson.hpp"
 #include "apps/phase_owners.hpp"
 #include "apps/roofline/lesson.hpp"
+#include "chapters/course.hpp"
 #include "chapters/registry.hpp"
 #include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
@@ -37,9 +38,9 @@ struct Found {
 // Every lesson of the course's chapters (variants aside), in chapter order, then the course's.
 std::vector<Found> course_lessons() {
   std::vector<Found> found;
-  for (const ChapterInfo& c : chapters())
-    if (c.lessons && c.variant_of.empty())
-      for (Lesson& l : c.lessons()) found.push_back({&c, std::move(l)});
+  for (const CourseChapter& c : course_chapters())
+    if (c.lessons && c.chapter->variant_of.empty())
+      for (Lesson& l : c.lessons()) found.push_back({c.chapter, std::move(l)});
   for (Lesson& l : roofline::lessons()) found.push_back({nullptr, std::move(l)});
   for (Lesson& l : frame_times::lessons()) found.push_back({nullptr, std::move(l)});
   return found;
@@ -61,8 +62,8 @@ std::string usage() {
 
 // The lesson `name` of chapter `id` (a variant has its own copy); throws UsageError.
 Lesson lesson_of(const ChapterInfo& chapter, const std::string& name) {
-  if (chapter.lessons)
-    for (Lesson& l : chapter.lessons())
+  if (const CourseChapter& course = course_of(chapter); course.lessons)
+    for (Lesson& l : course.lessons())
       if (l.name == name) return l;
   throw UsageError("chapter " + chapter.id + " has no lesson '" + name + "'");
 }

@@ -1,24 +1,20 @@
 #include "apps/phase_owners.hpp"
 
-#include <fstream>
 #include <functional>
 #include <iostream>
-#include <iterator>
 #include <map>
 #include <sstream>
-#include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "chapters/registry.hpp"
 #include "common/cli.hpp"
+#include "common/stepper.hpp"
 
 namespace fem {
 
 namespace {
 
-constexpr const char* kBegin = "<!-- phase-owners:begin -->\n";
-constexpr const char* kEnd = "<!-- phase-owners:end -->";
+constexpr const char* kMarkers = "phase-owners";  // <!-- phase-owners:begin/end -->
 
 // A part's chapter as its number where it is a chapter of the course, else its folder.
 std::string chapter_label(const std::string& folder) {
@@ -39,39 +35,21 @@ std::string cell(const ChapterInfo& chapter, const std::string& phase) {
   return out;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read " + path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// FILE's text with the table between its markers; throws if it has none.
-std::string with_table(const std::string& text, const std::string& path) {
-  const std::size_t begin = text.find(kBegin), end = text.find(kEnd);
-  if (begin == std::string::npos || end == std::string::npos || end < begin)
-    throw std::runtime_error(path + " has no phase-owners markers");
-  const std::size_t from = begin + std::string(kBegin).size();
-  return text.substr(0, from) + phase_owners_table() + text.substr(end);
-}
-
 }  // namespace
 
 std::string phase_owners_table() {
-  // The poster's phases, then the whole step (the parts around the phases: order and team).
-  static const char* const kPhases[] = {"forces",      "dfdx",  "compose",
-                                        "constraints", "solve", "step"};
+  // The profile's phases, the whole step last (the parts around the phases: order and team).
+  const auto& phases = StepProfile::phases();
   std::ostringstream out;
   out << "| chapter |";
-  for (const char* p : kPhases) out << " " << p << " |";
+  for (const StepProfile::Phase& p : phases) out << " " << p.name << " |";
   out << "\n| --- |";
-  for (std::size_t k = 0; k < std::size(kPhases); ++k) out << " --- |";
+  for (std::size_t k = 0; k < phases.size(); ++k) out << " --- |";
   out << "\n";
   for (const ChapterInfo& c : chapters()) {
     if (!c.variant_of.empty()) continue;
     out << "| " << c.id.substr(0, 2) << " |";
-    for (const char* p : kPhases) out << " " << cell(c, p) << " |";
+    for (const StepProfile::Phase& p : phases) out << " " << cell(c, p.name) << " |";
     out << "\n";
   }
   return out.str();
@@ -89,14 +67,12 @@ int phase_owners_command(int argc, char** argv) {
     if (!args.parse(argc, argv)) return 0;
     const std::string write = args.get("write"), check = args.get("check");
     if (!write.empty()) {
-      const std::string text = read_file(write), updated = with_table(text, write);
-      if (updated != text) std::ofstream(write) << updated;
+      write_between_markers(write, kMarkers, phase_owners_table());
       std::cout << "wrote the phase-owners table of " << write << "\n";
       return 0;
     }
     if (!check.empty()) {
-      const std::string text = read_file(check);
-      if (with_table(text, check) == text) return 0;
+      if (read_between_markers(check, kMarkers) == "\n" + phase_owners_table()) return 0;
       std::cerr << check << ": the phase-owners table is stale (fem_lessons phase-owners --write "
                 << check << ")\n";
       return 1;

@@ -1,9 +1,9 @@
 // The work of one step, phase by phase, as each chapter counts it from its own data: the
-// registry's `work` hook (registry.hpp), which the roofline lesson (apps/roofline) sets under
+// course list's `work` hook (course.hpp), which the roofline lesson (apps/roofline) sets under
 // the machine's roofs. A chapter counts its work in its own folder (chapters/NN_name/work.hpp
 // declares `count_work(const <its stepper>&, const Scene&, const WorkCounts&)` in its
-// namespace); a chapter that adds no data of its own is counted by the chapter it extends, and
-// a student's variant, a copy of the folder, by its own copy.
+// namespace); a chapter that adds no part of its own is counted by the parts of the chapters
+// it takes them from, and a student's variant, a copy of the folder, by its own copy.
 //
 // The model, kept simple so that a student can check it by hand (docs/roofline.md):
 //  - bytes read and bytes written: every array a phase reads or writes, once per pass over it
@@ -109,7 +109,7 @@ struct PartKernel {
   std::function<void()> run;  // one call, by every thread of a team (or by one thread)
 };
 
-// The hook of ChapterInfo: null for a chapter that counts nothing.
+// The hook of CourseChapter: null for a chapter that counts nothing.
 struct ChapterWork {
   std::vector<PhaseWork> (*count)(const Stepper&, const Scene&, const WorkCounts&) = nullptr;
   ExecutedWork (*executed)(const Stepper&) = nullptr;
@@ -120,9 +120,10 @@ struct ChapterWork {
 
 // The hook of a chapter whose stepper is S: count_work (and executed_work, if any) for S,
 // found by argument-dependent lookup (a chapter 01-07 stepper's own; from chapter 08 on the
-// sum of the recipe's parts' counts, chapters/08_element_kernels/work.hpp). The registry fills
-// ChapterInfo::work with it, for the steppers its `make` returns: those are S (inside
-// on_one_thread's wrapper, which unwrapped removes), so the casts below cannot fail.
+// sum of the recipe's parts' counts, chapters/08_element_kernels/work.hpp). The course's list
+// fills CourseChapter::work with it (chapters/course.hpp), for the steppers its `make` returns:
+// those are S (inside on_one_thread's wrapper, which unwrapped removes), so the casts below cannot
+// fail.
 template <class S, class = void>
 struct CountsWork : std::false_type {};
 template <class S>

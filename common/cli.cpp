@@ -320,6 +320,11 @@ MarkedDoc read_marked(const std::string& path, const std::string& name) {
 
 void check_markers(const std::string& path, const std::string& name) { read_marked(path, name); }
 
+std::string read_between_markers(const std::string& path, const std::string& name) {
+  const MarkedDoc doc = read_marked(path, name);
+  return doc.text.substr(doc.from, doc.to - doc.from);
+}
+
 void write_between_markers(const std::string& path, const std::string& name,
                            const std::string& text) {
   MarkedDoc doc = read_marked(path, name);

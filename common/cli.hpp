@@ -106,5 +106,8 @@ void write_between_markers(const std::string& path, const std::string& name,
                            const std::string& text);
 // The same checks alone, before the work whose text goes there (a lesson's measurement).
 void check_markers(const std::string& path, const std::string& name);
+// The text between the markers, as write_between_markers wrote it (from the newline after the
+// begin marker); throws as it does.
+std::string read_between_markers(const std::string& path, const std::string& name);
 
 }  // namespace fem

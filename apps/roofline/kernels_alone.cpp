@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 
+#include "chapters/course.hpp"
 #include "chapters/registry.hpp"
 #include "common/lesson.hpp"
 #include "common/threads.hpp"
@@ -21,11 +22,12 @@ constexpr int kSteps = 3;            // steps before the kernels run: A, the hie
 
 std::vector<KernelAlone> solve_kernels(const ChapterInfo& chapter, Stepper& stepper,
                                        const Scene& scene, double iterations) {
-  // The kernels are the stepper's parts' own (ChapterInfo::work.kernels), on the parts' data:
+  // The kernels are the stepper's parts' own (CourseChapter::work.kernels), on the parts' data:
   // the caller's own stepper, not one it steps on.
   std::vector<KernelAlone> kernels;
-  if (!chapter.work.kernels) return kernels;
-  for (PartKernel& k : chapter.work.kernels(stepper, scene, iterations)) {
+  const ChapterWork& work = course_of(chapter).work;
+  if (!work.kernels) return kernels;
+  for (PartKernel& k : work.kernels(stepper, scene, iterations)) {
     KernelAlone alone;
     alone.name = std::move(k.name);
     alone.part = std::move(k.part);

@@ -36,7 +36,7 @@ struct KernelAlone {
 // solve. Empty for a stepper of an earlier chapter. The stepper must have taken a step; the
 // kernels write its work vectors.
 // The solve's kernels of `stepper`, which `chapter` made and which ran a few steps, at
-// `iterations` PCG iterations a step: its parts' own (ChapterInfo::work.kernels).
+// `iterations` PCG iterations a step: its parts' own (CourseChapter::work.kernels).
 std::vector<KernelAlone> solve_kernels(const ChapterInfo& chapter, Stepper& stepper,
                                        const Scene& scene, double iterations);
 

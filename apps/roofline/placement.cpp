@@ -4,6 +4,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "chapters/course.hpp"
 #include "common/lesson.hpp"
 #include "common/threads.hpp"
 
@@ -79,9 +80,8 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
   State state = rest_state(scene);
   std::vector<StepProfile> profiles;
   std::vector<int> teams;  // the threads each measured step ran on (0: not said)
-  const auto executed = [&] {
-    return chapter.work.executed ? chapter.work.executed(stepper) : ExecutedWork{};
-  };
+  const ChapterWork& work = course_of(chapter).work;
+  const auto executed = [&] { return work.executed ? work.executed(stepper) : ExecutedWork{}; };
   ExecutedWork before;
   for (int k = 0; k < warmup + steps; ++k) {
     if (k == warmup) before = executed();
@@ -101,9 +101,8 @@ PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& sce
   std::vector<double> iterations;
   for (const StepProfile& p : profiles) iterations.push_back(p.cg_iterations);
   run.iterations = median(iterations);
-  if (!chapter.work.count) return run;  // measured, not counted
-  for (const PhaseWork& w :
-       chapter.work.count(stepper, scene, WorkCounts{run.iterations, run.executed})) {
+  if (!work.count) return run;  // measured, not counted
+  for (const PhaseWork& w : work.count(stepper, scene, WorkCounts{run.iterations, run.executed})) {
     run.phases.push_back(place_phase(w, record_phase(w.phase, profiles, teams, roofs), roofs));
     run.bound_s += run.phases.back().bound_s;
   }

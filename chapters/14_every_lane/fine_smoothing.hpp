@@ -1,10 +1,11 @@
 // The V-cycle's finest level in float with its products in vector lanes filled across blocks:
 // the polynomial smoothing step and the residual, which the V-cycle runs on it some twelve
 // times per cycle, and which alone took two thirds of a step with a quarter of the lanes busy.
-// Two layouts: a row's blocks in pairs (paired_blocks.hpp, 256-bit registers) and two rows'
-// pairs side by side (row_pairs.hpp, 512-bit registers, three 128-bit inserts and three
-// permutes of 512 bits per four blocks). On the AMD EPYC this was measured on (family 26 by
-// its cpuid: Zen 5) the pairs are the faster by far (lanes_bench); measure on other cores.
+// The step runs a row's blocks in pairs (paired_blocks.hpp, 256-bit registers). The course
+// measures a second layout beside it, two rows' pairs side by side (row_pairs.hpp, 512-bit
+// registers, three 128-bit inserts and three permutes of 512 bits per four blocks): on the AMD
+// EPYC this was measured on (family 26 by its cpuid: Zen 5) the pairs are the faster by far
+// (lanes_bench); measure on other cores.
 //
 // A part for a stepper: a level type of the V-cycle (v_cycle.hpp's interface, found by
 // argument-dependent lookup) that views a float level (its inverse diagonal, weights and
@@ -20,7 +21,6 @@
 #include "chapters/12_half_the_bytes/reduced_kernels.hpp"
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
 #include "chapters/14_every_lane/paired_blocks.hpp"
-#include "chapters/14_every_lane/row_pairs.hpp"
 #include "chapters/work.hpp"
 
 namespace fem::ch14 {
@@ -28,7 +28,7 @@ namespace fem::ch14 {
 using FloatLevel = ch12::ReducedLevel<float, 3>;
 using CoarseFloatLevel = ch12::ReducedLevel<float, ch10::kModes>;
 
-// The layout of a level's pattern (and its row blocks, for the row pairs).
+// The layout of a level's pattern.
 using PaddedFloatBlocks = PairedBlocks<float, false>;
 inline PaddedFloatBlocks lanes_of(const ch10::Level<3>& level, const PaddedFloatBlocks*) {
   return PaddedFloatBlocks(level.A);
@@ -36,9 +36,6 @@ inline PaddedFloatBlocks lanes_of(const ch10::Level<3>& level, const PaddedFloat
 using PackedFloatBlocks = PairedBlocks<float, true>;
 inline PackedFloatBlocks lanes_of(const ch10::Level<3>& level, const PackedFloatBlocks*) {
   return PackedFloatBlocks(level.A);
-}
-inline RowPairBlocks lanes_of(const ch10::Level<3>& level, const RowPairBlocks*) {
-  return RowPairBlocks(level.A, level.rows.part);
 }
 
 template <class Blocks>
@@ -67,7 +64,6 @@ struct LaneLevel : ch10::PolynomialLevel {
   Blocks blocks;
 };
 using LaneFineLevel = LaneLevel<PaddedFloatBlocks>;    // the pair lanes, padded
-using RowPairFineLevel = LaneLevel<RowPairBlocks>;     // the row pairs
 using PackedFineLevel = LaneLevel<PackedFloatBlocks>;  // the pair lanes, packed
 
 // Step k of the polynomial smoother on rows [first, last) of whole row blocks (from zero when

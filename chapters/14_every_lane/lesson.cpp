@@ -10,6 +10,7 @@
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/10_multigrid/v_cycle.hpp"
 #include "chapters/10_multigrid/work.hpp"
+#include "chapters/14_every_lane/row_pairs.hpp"
 #include "chapters/14_every_lane/stepper.hpp"
 #include "common/threads.hpp"
 

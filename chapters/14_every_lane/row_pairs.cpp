@@ -2,6 +2,9 @@
 
 #include <algorithm>
 
+#include "chapters/10_multigrid/v_cycle.hpp"
+#include "chapters/14_every_lane/fine_smoothing_rows.hpp"
+
 namespace fem::ch14 {
 
 // Rows paired from each part's first; per pair, as many steps as its longer row has pairs of
@@ -38,5 +41,15 @@ double RowPairBlocks::bytes() const {
          double(x_offset_.size() + step_start_.size() + group_.size()) * sizeof(int) +
          double(at_end_.size());
 }
+
+// The row pairs' level brings every kernel the V-cycle calls, as the step's layouts do
+// (fine_smoothing.cpp).
+static_assert(ch10::check_level_kernels<RowPairFineLevel, CoarseFloatLevel, Eigen::VectorXf>());
+
+template void smooth_rows(RowPairFineLevel&, int, int, int, const Eigen::VectorXf&,
+                          const Eigen::VectorXf*, Eigen::VectorXf&);
+template void residual_rows(RowPairFineLevel&, int, int, const Eigen::VectorXf&,
+                            const Eigen::VectorXf&);
+template struct LaneLevel<RowPairBlocks>;
 
 }  // namespace fem::ch14

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "chapters/07_block_sparse/block_sparse.hpp"
+#include "chapters/14_every_lane/fine_smoothing.hpp"
 #include "chapters/14_every_lane/lanes.hpp"
 
 namespace fem::ch14 {
@@ -175,5 +176,12 @@ inline void RowPairBlocks::row_products(int i, const float* x, Eigen::Array4f& f
   }
   RowPairLanes::totals(acc, first, second);
 }
+
+// The row pairs as the V-cycle's finest level (fine_smoothing.hpp): the course measures it
+// beside the step's pair lanes (lesson.cpp, apps/roofline/lanes_bench.cpp); no stepper runs it.
+inline RowPairBlocks lanes_of(const ch10::Level<3>& level, const RowPairBlocks*) {
+  return RowPairBlocks(level.A, level.rows.part);
+}
+using RowPairFineLevel = LaneLevel<RowPairBlocks>;
 
 }  // namespace fem::ch14

@@ -17,6 +17,7 @@
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/14_every_lane/fine_smoothing.hpp"
 #include "chapters/14_every_lane/lane_product.hpp"
+#include "chapters/14_every_lane/row_pairs.hpp"
 #include "common/alloc_counter.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"

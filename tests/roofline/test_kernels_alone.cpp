@@ -11,6 +11,7 @@
 #include "catch2_compat.hpp"
 #include "chapters/09_threads/stepper.hpp"
 #include "chapters/10_multigrid/stepper.hpp"
+#include "chapters/course.hpp"
 #include "chapters/registry.hpp"
 #include "common/build_info.hpp"
 #include "support.hpp"
@@ -36,8 +37,9 @@ Stepped stepped(const std::string& id, const Scene& scene) {
   for (int k = 0; k < 2; ++k) s.stepper->step(state);
   s.iterations = s.stepper->profile().cg_iterations;
   s.kernels = solve_kernels(chapter, *s.stepper, scene, s.iterations);
-  REQUIRE(chapter.work.count);
-  for (const PhaseWork& w : chapter.work.count(*s.stepper, scene, WorkCounts{s.iterations, {}}))
+  REQUIRE(course_of(chapter).work.count);
+  for (const PhaseWork& w :
+       course_of(chapter).work.count(*s.stepper, scene, WorkCounts{s.iterations, {}}))
     if (w.phase == "solve") s.solve = w;
   REQUIRE(!s.solve.parts.empty());
   return s;

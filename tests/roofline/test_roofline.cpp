@@ -21,6 +21,7 @@
 #include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/12_half_the_bytes/work.hpp"
+#include "chapters/course.hpp"
 #include "chapters/registry.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
@@ -42,15 +43,15 @@ std::vector<PhaseWork> stepped_work(const ChapterInfo& chapter, Stepper& stepper
                                     const Scene& scene, int steps) {
   State state = rest_state(scene);
   for (int k = 0; k < steps; ++k) stepper.step(state);
-  REQUIRE(chapter.work.count);
+  REQUIRE(course_of(chapter).work.count);
   WorkCounts counts{double(stepper.profile().cg_iterations), {}};
-  if (chapter.work.executed) {
-    counts.per_step = chapter.work.executed(stepper);
+  if (course_of(chapter).work.executed) {
+    counts.per_step = course_of(chapter).work.executed(stepper);
     const double n = counts.per_step.steps;
     counts.per_step = {1.0, counts.per_step.rotations / n, counts.per_step.rotation_iterations / n,
                        counts.per_step.rotation_fallbacks / n};
   }
-  return chapter.work.count(stepper, scene, counts);
+  return course_of(chapter).work.count(stepper, scene, counts);
 }
 
 }  // namespace
@@ -126,8 +127,8 @@ TEST_CASE("roofline: the element pass's flops are the Newton iterations it count
     const auto stepper = chapter.make(scene, {});
     State state = rest_state(scene);
     for (int k = 0; k < 3; ++k) stepper->step(state);
-    REQUIRE(chapter.work.executed);
-    const ExecutedWork e = chapter.work.executed(*stepper);
+    REQUIRE(course_of(chapter).work.executed);
+    const ExecutedWork e = course_of(chapter).work.executed(*stepper);
     const double elements = scene.mesh.num_tets();
     CHECK(e.steps == 3.0);
     CHECK(e.rotations == 3.0 * elements);
@@ -136,7 +137,7 @@ TEST_CASE("roofline: the element pass's flops are the Newton iterations it count
     CHECK(e.rotation_iterations <= e.rotations * ch08::newton::kMaxIterations);
     const WorkCounts counts{
         1.0, {1.0, e.rotations / 3, e.rotation_iterations / 3, e.rotation_fallbacks / 3}};
-    const auto work = chapter.work.count(*stepper, scene, counts);
+    const auto work = course_of(chapter).work.count(*stepper, scene, counts);
     const double expected = elements * ch08::fused_element_flops() +
                             e.rotation_iterations / 3 * ch08::newton_iteration_flops() +
                             e.rotations / 3 * ch08::newton_finish_flops();

@@ -1,16 +1,20 @@
-"""Writes docs/diffs/NN_name.diff: the lesson of each chapter as a diff against the chapter
-before. Every source file of the chapter's folder (.hpp, .cpp) is diffed against the file of
-the same name in the previous chapter, in reading order (source_files); a file the previous chapter does not have shows as
-added, and so does a file that includes its namesake of the previous chapter (chapter 10's
-stepper extends chapter 09's instead of copying it), as do the lesson measurements
-(lesson.hpp, lesson.cpp), which never copy forward. Before diffing, the previous chapter's
-text gets the current chapter's names (namespace chNN, stepper class, chapter id, its own
-header's path, "Chapter NN"), so that no hunk is a rename. It also writes the table of each
-chapter's files and what it includes from earlier chapters into chapters/README.md (between
-its chapter-files markers; the table of which part runs each phase, between its phase-owners
-markers, is the program's: `fem_lessons phase-owners --write chapters/README.md`, from the
-steppers' recipes). With --check, writes nothing and exits 1 if a committed diff or the files
-table is stale or any hunk only changes names.
+"""Writes docs/diffs/NN_name.diff: the lesson of each chapter as a diff against the chapter it
+builds on (femtools.course.tree.parent_of: the recipe's BuildsOn from chapter 09 on, else the
+chapter before). Every source file of the chapter's folder (.hpp, .cpp), in reading order
+(source_files), is diffed against the file of the same name in the parent only where the
+chapter copied it (copied_files): the parent has the name, and no file of the chapter includes
+the parent's file of that name (nor its header), which would make it a new file that shares a
+name, such as a parts.hpp beside the parent's. A recipe (chapter 09 on) copies only its
+stepper.hpp, diffed against its parent's; its parts are its own files. Every other file shows as added,
+and so do the lesson measurements (lesson.hpp, lesson.cpp), which never copy forward. Before
+diffing, the parent's code gets the chapter's names (namespace chNN, stepper class, chapter id,
+the paths of the files it copied), so that no hunk is a rename; its words stay its own
+("Chapter 12" stays "Chapter 12"). It also writes the table of each chapter's files and what
+it includes from earlier chapters into chapters/README.md (between its chapter-files markers;
+the table of which part runs each phase, between its phase-owners markers, is the program's:
+`fem_lessons phase-owners --write chapters/README.md`, from the steppers' recipes). With
+--check, writes nothing and exits 1 if a committed diff or the files table is stale or any hunk
+only changes names.
 
     fem-tools docs diffs                    # regenerate
     fem-tools docs diffs --check            # compare with the committed ones
@@ -23,42 +27,46 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.course import variant as make_variant
+from femtools.course.tree import BUILDS_ON, course_chapters, parent_of
 from femtools.docs.markers import replace_between
+
 STEPPER_CLASS = re.compile(r"class\s+(\w+)\s+(?:final\s+)?:\s*public\s+[\w:]*Stepper\b"
                            r"|using\s+(\w+)\s*=\s*[\w:]*StepOf<")
 ALWAYS_ADDED = ("lesson.hpp", "lesson.cpp")
 
 
 def chapter_dirs(root):
-    """The course's chapters: a student's variant (./tutorial.sh variant, marked by its
-    variant_of file) is no lesson, and its diff against the original is the student's own."""
-    return sorted(d for d in (root / "chapters").iterdir()
-                  if d.is_dir() and d.name[:2].isdigit() and (d / "stepper.hpp").exists()
-                  and not (d / "variant_of").exists())
+    """The course's chapters: a student's variant is no lesson, and its diff against the
+    original is the student's own (variant_diff)."""
+    return course_chapters(root)
 
 
 def names(chapter):
-    """What is renamed from chapter to chapter: namespace, stepper class, id, number."""
-    match = STEPPER_CLASS.search((chapter / "stepper.hpp").read_text())
-    namespace = re.search(r"namespace fem::(\w+) \{", (chapter / "stepper.hpp").read_text())
+    """What is renamed from chapter to chapter: namespace, stepper class, recipe, id, number."""
+    text = (chapter / "stepper.hpp").read_text()
+    match = STEPPER_CLASS.search(text)
+    namespace = re.search(r"namespace fem::(\w+) \{", text)
+    recipe = re.search(r"StepOf<(\w+)>", text)
     return {"id": chapter.name, "number": chapter.name[:2],
             "namespace": namespace.group(1) if namespace else "",
-            "class": (match.group(1) or match.group(2)) if match else ""}
+            "class": (match.group(1) or match.group(2)) if match else "",
+            "recipe": recipe.group(1) if recipe else ""}
 
 
 def renamed(text, old, new, files=()):
-    """text of chapter `old` with the names of chapter `new`, whose folder holds `files`."""
-    # Its own stepper.hpp and work.hpp (the registry's files), and any header the new chapter
-    # has a file of the same name for (a chapter that starts as a copy of the last), under its
-    # own name.
-    own = "|".join(re.escape(f) for f in sorted({"stepper.hpp", "work.hpp", *files}))
+    """text of chapter `old` with the code names of chapter `new` (namespace, stepper, recipe), which copied `files` from
+    it; the words stay the old text's ("Chapter NN" is not renamed)."""
+    # Its stepper.hpp (the registry's file) and the files the new chapter copied, under the new
+    # chapter's path.
+    own = "|".join(re.escape(f) for f in sorted({"stepper.hpp", *files}))
     text = re.sub(rf"chapters/{old['id']}/({own})\b", rf"chapters/{new['id']}/\1", text)
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
     if old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
-    if old["class"] and new["class"]:
-        text = re.sub(rf"\b{old['class']}\b", new["class"], text)
-    return re.sub(rf"\bChapter {old['number']}\b", f"Chapter {new['number']}", text)
+    for name in ("class", "recipe"):
+        if old[name] and new[name]:
+            text = re.sub(rf"\b{old[name]}\b", new[name], text)
+    return text
 
 
 def source_files(chapter):
@@ -77,33 +85,53 @@ def source_files(chapter):
     return sorted((p for p in chapter.iterdir() if p.suffix in (".hpp", ".cpp")), key=key)
 
 
-def file_diff(previous, current, name, root):
+def includes_of(chapter):
+    """The (folder, file) pairs the chapter's sources include from chapters/."""
+    return {m.groups() for p in chapter.iterdir() if p.suffix in (".hpp", ".cpp")
+            for m in INCLUDE.finditer(p.read_text())}
+
+
+def copied_files(parent, chapter):
+    """The chapter's files that are copies of its parent's: the parent has a file of the name,
+    and the chapter includes neither it nor its header (a chapter that includes the parent's
+    parts.hpp and has a parts.hpp of its own wrote a new one). A recipe (a chapter whose
+    stepper.hpp names BuildsOn) copies its stepper.hpp only: it includes its parent's to name it,
+    and its diff is the lesson; every part it adds is a file of its own (chapter 10's work.hpp
+    counts its V-cycle, chapter 09's its threads: the same name, no line in common to diff)."""
+    if BUILDS_ON.search((chapter / "stepper.hpp").read_text()):
+        return {"stepper.hpp"} if (parent / "stepper.hpp").exists() else set()
+    included = {name for folder, name in includes_of(chapter) if folder == parent.name}
+    return {path.name for path in chapter.iterdir()
+            if path.suffix in (".hpp", ".cpp") and path.name not in ALWAYS_ADDED
+            and (parent / path.name).exists()
+            and path.name not in included and f"{path.stem}.hpp" not in included}
+
+
+def file_diff(parent, current, name, root, copied):
     b = current / name
-    a = previous / name
     new_lines = b.read_text().splitlines(keepends=True)
-    # The chapter extends the previous one's file instead of copying it: its header (same
-    # stem, .hpp) includes the previous chapter's.
-    header = current / (pathlib.Path(name).stem + ".hpp")
-    extends = header.exists() and f'#include "chapters/{previous.name}/{header.name}"' in header.read_text()
-    if name in ALWAYS_ADDED or not a.exists() or extends:
+    if name not in copied:
         return list(difflib.unified_diff([], new_lines, fromfile="/dev/null",
                                          tofile=str(b.relative_to(root))))
-    old_text = renamed(a.read_text(), names(previous), names(current),
-                       [p.name for p in current.iterdir() if p.suffix == ".hpp"])
+    a = parent / name
+    old_text = renamed(a.read_text(), names(parent), names(current), copied)
     return list(difflib.unified_diff(old_text.splitlines(keepends=True), new_lines,
                                      fromfile=str(a.relative_to(root)),
                                      tofile=str(b.relative_to(root))))
 
 
-def diff(previous, current, root):
+def diff(parent, current, root):
+    """The chapter `current` against the chapter it builds on, `parent`."""
+    copied = copied_files(parent, current)
     out = []
     for path in source_files(current):
-        out += file_diff(previous, current, path.name, root)
+        out += file_diff(parent, current, path.name, root, copied)
     return "".join(out)
 
 
+# The code's names of a chapter (not "Chapter NN", a word of the text, which the diff keeps).
 GENERIC = [(re.compile(r"\bch\d\d\w*"), "chNN"), (re.compile(r"\b\d\d_[a-z]\w*"), "NN_name"),
-           (re.compile(r"\b\w+Stepper\b"), "Stepper"), (re.compile(r"\bChapter \d\d\b"), "Chapter NN")]
+           (re.compile(r"\b\w+Stepper\b"), "Stepper")]
 
 
 def rename_only_hunks(text):
@@ -199,9 +227,9 @@ def main(argv=None, prog=None):
     out_dir = args.root / "docs" / "diffs"
     dirs = chapter_dirs(args.root)
     stale, renames = [], []
-    for previous, current in zip(dirs, dirs[1:]):
+    for current in dirs[1:]:
         path = out_dir / f"{current.name}.diff"
-        text = diff(previous, current, args.root)
+        text = diff(parent_of(current), current, args.root)
         renames += [f"{path.name}: {h}" for h in rename_only_hunks(text)]
         if args.check:
             if not path.exists() or path.read_text() != text:

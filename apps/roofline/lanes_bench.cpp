@@ -5,13 +5,19 @@
 // in one run, and set beside the bound of each one's own bytes and flops under the machine's
 // roofs measured in the same run.
 //
+// Chapter 14's probe, kept with the roofline's programs because it times with their code
+// (kernels_alone.hpp, roofs.hpp): no file under chapters/ includes one under apps/.
+//
 //   lanes_bench [--mesh meshes/plate_poster.msh] [--rounds 5] [--roof-seconds 0.3] [--threads N]
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -26,6 +32,8 @@
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/14_every_lane/fine_smoothing.hpp"
 #include "chapters/14_every_lane/lane_product.hpp"
+#include "chapters/14_every_lane/row_pairs.hpp"
+#include "common/cli.hpp"
 #include "common/mesh.hpp"
 #include "common/threads.hpp"
 
@@ -34,21 +42,33 @@ using namespace fem;
 namespace {
 
 struct Options {
-  std::string mesh = "meshes/plate_poster.msh";
-  int rounds = 5;
-  double roof_seconds = 0.3;
+  std::string mesh;
+  int rounds = 0;
+  double roof_seconds = 0.0;
   int threads = 0;  // 0: 1 and 2 threads
 };
 
-Options parse(int argc, char** argv) {
+// The options, or nothing after --help; throws UsageError for an unknown option or a bad value.
+std::optional<Options> parse(int argc, char** argv) {
+  ArgParser args("lanes_bench",
+                 "Chapter 14's pair lanes' kernels alone against the kernels they replace, old "
+                 "and new alternated, each beside the bound of its own bytes and flops under the "
+                 "machine's roofs.");
+  args.option("mesh", "FILE", "the mesh whose system and finest level the kernels run on",
+              "meshes/plate_poster.msh");
+  args.option("rounds", "N", "rounds of old and new timings, alternated (the best is kept)", "5");
+  args.option("roof-seconds", "S", "seconds per roof measurement; 0: no roofs, times only", "0.3");
+  args.option("threads", "N", "time at N threads only; 0: at 1 and 2", "0");
+  if (!args.parse(argc, argv)) return std::nullopt;
   Options o;
-  for (int a = 1; a + 1 < argc; a += 2) {
-    const std::string key = argv[a], value = argv[a + 1];
-    if (key == "--mesh") o.mesh = value;
-    if (key == "--rounds") o.rounds = std::stoi(value);
-    if (key == "--roof-seconds") o.roof_seconds = std::stod(value);
-    if (key == "--threads") o.threads = std::stoi(value);
-  }
+  o.mesh = resolve_mesh_path(args.get("mesh"));
+  o.rounds = args.get_int("rounds");
+  o.roof_seconds = args.get_double("roof-seconds");
+  o.threads = args.get_int("threads");
+  if (o.rounds < 1) throw UsageError("--rounds must be at least 1");
+  if (!(o.roof_seconds >= 0.0)) throw UsageError("--roof-seconds must be 0 or more");
+  if (o.threads < 0 || o.threads > 2) throw UsageError("--threads must be 0, 1 or 2");
+  if (!std::filesystem::is_regular_file(o.mesh)) throw UsageError("no mesh file " + o.mesh);
   return o;
 }
 
@@ -167,17 +187,17 @@ void time_fills(ch14::LaneFineLevel& fine, ch14::LaneProduct& product,
               1e6 * product_fill);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Options o = parse(argc, argv);
+// Times the kernels of a cantilever on the mesh after three steps of chapter 12's stepper (the
+// system and hierarchy the lanes are built from).
+int bench(const Options& o) {
   std::printf("load before: %s\n", load_average().c_str());
   const Scene scene = make_scene("cantilever", load_mesh(o.mesh));
   ch12::HalfBytesStepper stepper(scene, SolverSettings{});
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
   ch12::ReducedVCycle<float>* cycle = &stepper.preconditioner().v_cycle();
-  if (!cycle || stepper.preconditioner().multigrid().levels() < 2) return 1;
+  if (!cycle || stepper.preconditioner().multigrid().levels() < 2)
+    throw std::runtime_error(o.mesh + " gives a multigrid of one level: no finest level to time");
   ch14::LaneFineLevel fine(cycle->fine_level());
   fine.fill(0, fine.blocks.rows());
   ch14::RowPairFineLevel row_pairs(cycle->fine_level());
@@ -222,4 +242,13 @@ int main(int argc, char** argv) {
   time_fills(fine, product, A);
   std::printf("load after: %s\n", load_average().c_str());
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return run_program("lanes_bench", [&] {
+    const std::optional<Options> o = parse(argc, argv);
+    return o ? bench(*o) : 0;
+  });
 }
