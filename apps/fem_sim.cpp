@@ -11,6 +11,7 @@
 #include "common/deformation.hpp"
 #include "common/run_lock.hpp"
 #include "common/stepper.hpp"
+#include "common/threads.hpp"
 #include "common/vtk.hpp"
 #include "femcourse/simulator.hpp"
 

@@ -19,6 +19,8 @@ namespace femcourse {
 inline namespace FEMCOURSE_ABI {
 namespace {
 
+constexpr int kMostSubsteps = 1000;  // more is a typo: a step() of a thousand steps' cost
+
 [[noreturn]] void refuse(const std::string& problem) {
   throw std::invalid_argument("femcourse::Body: " + problem);
 }
@@ -179,7 +181,6 @@ class StepThreads {
 };
 
 constexpr std::size_t kKeptWarnings = 64;
-constexpr int kMostSubsteps = 1000;  // more is a typo: a step() of a thousand steps' cost
 
 }  // namespace
 
