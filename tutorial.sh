@@ -371,7 +371,7 @@ compare() {
 variant() {
   [ $# -eq 2 ] || { echo "usage: ./tutorial.sh variant NN NAME (e.g. 06 my_fused_updates)" >&2; exit 2; }
   setup_python
-  fem_tools course variant "$@"
+  fem_tools course variant -- "$@"  # after --: a name such as -x is checked as a name
 }
 
 # A teacher's check of a hand-in (fem-tools course handin --help): the variant's sources against
@@ -533,6 +533,16 @@ book_stage() {  # book_stage NAME COMMAND...: one timed stage, with the time lef
   BOOK_TIMES+=("$name=$((SECONDS - start))")
 }
 
+# replace_folder NEW OLD: NEW takes OLD's name, in two renames (the earlier folder is removed
+# only after NEW has its name; a folder cannot be renamed over a full one in one step).
+replace_folder() {
+  local new=$1 old=$2
+  rm -rf "$old.old"
+  if [ -e "$old" ]; then mv "$old" "$old.old"; fi
+  mv "$new" "$old"
+  rm -rf "$old.old"
+}
+
 book() {
   [ "${1:-}" = "--busy" ] || book_quiet_check
   if [ -n "$(git status --porcelain -- chapters common apps)" ]; then
@@ -552,8 +562,11 @@ book() {
   local started
   started=$(date +%s)
   book_stage meshes meshes --large
-  rm -rf results/book
-  book_stage bench bench --out results/book --replace
+  # The new run is recorded beside the earlier one and replaces it only once it is whole: a
+  # bench stopped (Ctrl-C) or failed leaves results/book as it was.
+  rm -rf results/book.new
+  book_stage bench bench --out results/book.new
+  replace_folder results/book.new results/book
   book_stage threads threads
   book_stage scaling scaling
   book_stage regimes regimes

@@ -161,8 +161,11 @@ int run_lesson(const Found& found, int argc, char** argv) {
     // The program's thread count again after the lesson: record-all runs the next lesson
     // with its own --threads or none (chapter 10's is recorded with --threads 1).
     const ThreadCountScope program_threads(max_threads());
+    const AskedThreadsScope program_asked(thread_count_asked());
     threads_from_args(args);
     check_chapter_lists(args);
+    // The roofline's second count, held to --threads' rule before any roof (0 would run as 1).
+    if (args.has_option("threads-max")) thread_counts_from_args(args, "threads-max");
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");

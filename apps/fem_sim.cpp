@@ -11,6 +11,7 @@
 #include "common/deformation.hpp"
 #include "common/run_lock.hpp"
 #include "common/stepper.hpp"
+#include "common/threads.hpp"
 #include "common/vtk.hpp"
 #include "femcourse/simulator.hpp"
 
@@ -30,7 +31,21 @@ struct Stopped {  // not a std::exception: main() answers it with 130, as a shel
 struct Run {
   const ChapterInfo* chapter = nullptr;
   int steps = 0, every = 0, threads = 1, watch = -1;
+  bool threads_asked = false;  // --threads or OMP_NUM_THREADS: every step runs on `threads`
   SolverSettings solver;
+};
+
+// The threads the steps ran on, as the stepper's team recorded them step by step.
+struct TeamsRan {
+  int fewest = 0, most = 0;
+  void add(int team) {
+    fewest = fewest == 0 ? team : std::min(fewest, team);
+    most = std::max(most, team);
+  }
+  std::string text() const {
+    return fewest == most ? std::to_string(most)
+                          : std::to_string(fewest) + " to " + std::to_string(most);
+  }
 };
 
 void add_options(ArgParser& args) {
@@ -66,6 +81,7 @@ Run run_from_args(const ArgParser& args) {
   if (run.every < 0) throw UsageError("--every must be >= 0");
   run.solver = solver_from_args(args);
   run.threads = threads_from_args(args);
+  run.threads_asked = thread_count_asked();
   if (run.every > 0) {
     try {
       VtkSeries::check_writable(args.get("out"));
@@ -84,13 +100,14 @@ void print_progress(int k, const Run& run, const Scene& scene, const StepProfile
 
 // The steps, with a line every tenth of the run, a frame every `every` steps, and a warning
 // for a step that diverged (an error) or that left the body in trouble (common/deformation.hpp).
-void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& series) {
+TeamsRan simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& series) {
   const Scene& scene = body.scene();
   const State& state = body.state();
   if (series) series->write_frame(0.0, scene.mesh.X, scene.mesh.tets, state.x, state.v);
   const DeformationProbe probe(scene);
   DeformationReport deformation;
   const int report_every = std::max(1, run.steps / 10);
+  TeamsRan teams;
   for (int k = 1; k <= run.steps; ++k) {
     if (stop_requested) throw Stopped{k - 1};
     const auto start = std::chrono::steady_clock::now();
@@ -101,6 +118,7 @@ void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& s
                                e.reason +
                                "); try a smaller --dt, or check --E, --rho, --alpha and --beta");
     }
+    teams.add(body.threads_used());
     // The first step allocates the stepper's buffers: the estimate is taken from the second.
     if (k == 2)
       announce_long_run(
@@ -114,6 +132,7 @@ void simulate(const Run& run, femcourse::Body& body, std::optional<VtkSeries>& s
       print_progress(k, run, scene, body.stepper().profile());
   }
   deformation.summary(run.steps);
+  return teams;
 }
 
 // The watched node's position at the end, to every digit: the library's example compares
@@ -145,6 +164,7 @@ std::optional<RunLock> lock_output(const ArgParser& args, const Run& run) {
 void run_scene(const ArgParser& args, const Run& run) {
   const std::optional<RunLock> lock = lock_output(args, run);
   femcourse::Body body(scene_from_args(args), run.solver, run.chapter->id);
+  if (run.threads_asked) body.set_threads(run.threads);  // else the library's choice
   const Scene& scene = body.scene();
   if (run.watch >= scene.mesh.num_nodes())
     throw UsageError("--watch " + std::to_string(run.watch) + ": the mesh has " +
@@ -154,8 +174,12 @@ void run_scene(const ArgParser& args, const Run& run) {
             << run.chapter->id << ", " << run.steps << " steps of " << scene.dt << " s"
             << std::endl;
   const bool threaded = body.stepper().uses_threads();
-  std::cout << "threads: " << (threaded ? run.threads : 1)
-            << (threaded ? "" : " (this chapter is single-threaded)") << "\n";
+  std::cout << "threads: "
+            << (!threaded           ? "1 (this chapter is single-threaded)"
+                : run.threads_asked ? std::to_string(run.threads) + " (asked: every step)"
+                                    : "not asked: the library's choice (one thread below " +
+                                          std::to_string(femcourse::kSmallBodyNodes) + " nodes)")
+            << "\n";
   if (args.has_flag("verbose")) std::cout << "stepper: " << body.stepper();
   // The new series replaces an earlier one only once it is whole (common/vtk.hpp): a run
   // that fails part-way leaves the earlier series as it was.
@@ -164,8 +188,9 @@ void run_scene(const ArgParser& args, const Run& run) {
   const auto start = std::chrono::steady_clock::now();
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
+  TeamsRan teams;
   try {
-    simulate(run, body, series);
+    teams = simulate(run, body, series);
   } catch (const Stopped& stopped) {
     std::cout << "fem_sim: stopped after step " << stopped.steps_done << " of " << run.steps;
     if (series)
@@ -187,6 +212,8 @@ void run_scene(const ArgParser& args, const Run& run) {
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The team's own record, not the option: what a comparison of thread counts relies on.
+  std::cout << "threads the steps ran on: " << teams.text() << "\n";
   std::cout << "done in " << seconds << " s";
   if (series)
     std::cout << "; " << series->frames() << " frames, open " << series->pvd_path()

@@ -40,10 +40,38 @@ fs::path temporary_name(const fs::path& path) {
          ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()));
 }
 
+const char* kind_of(fs::file_type type) {
+  switch (type) {
+    case fs::file_type::directory:
+      return "a directory";
+    case fs::file_type::character:
+      return "a character device";
+    case fs::file_type::block:
+      return "a block device";
+    case fs::file_type::fifo:
+      return "a FIFO (named pipe)";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "not a file";
+  }
+}
+
 }  // namespace
+
+std::string not_a_regular_file(const std::string& path) {
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);  // follows links: /dev/stdout
+  if (error || !fs::exists(status) || fs::is_regular_file(status)) return "";
+  return std::string("it is ") + kind_of(status.type()) +
+         ", not a regular file: writing would replace it (or wait for a reader); give a file's "
+         "path";
+}
 
 void write_file_atomically(const std::string& path, const std::string& text) {
   const fs::path target(path), temporary = temporary_name(target);
+  if (const std::string cause = not_a_regular_file(path); !cause.empty())
+    throw WriteError("cannot write '" + path + "': " + cause);
   const auto fail = [&](int cause) {
     ::unlink(temporary.c_str());
     throw WriteError("cannot write '" + path + "': " + std::strerror(cause));
@@ -63,9 +91,8 @@ void write_file_atomically(const std::string& path, const std::string& text) {
 
 void check_writable(const std::string& path) {
   const fs::path target(path);
-  std::error_code error;
-  if (fs::is_directory(target, error))
-    throw WriteError("cannot write '" + path + "': it is a directory");
+  if (const std::string cause = not_a_regular_file(path); !cause.empty())
+    throw WriteError("cannot write '" + path + "': " + cause);
   const fs::path temporary = temporary_name(target);
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) throw WriteError("cannot write '" + path + "': " + std::strerror(errno));

@@ -27,9 +27,17 @@ void write_file_atomically(const std::string& path,
 // The same for text already made.
 void write_file_atomically(const std::string& path, const std::string& text);
 
+// A path that exists and is not a regular file (a device such as /dev/null, a FIFO, a socket,
+// a directory; a symbolic link counts as what it points to): the rename would replace the
+// node itself (as root, /dev/null), and opening a FIFO blocks until a reader comes. Returns
+// "it is CAUSE, not a regular file: ..." for such a path, "" otherwise (no such file, or a
+// regular one). Every writer below refuses such a target with it: "cannot write 'PATH': ...".
+std::string not_a_regular_file(const std::string& path);
+
 // Before the work: tries what the write will do (makes the temporary name in the folder and
 // removes it again), so that a run does not end in "cannot write". Throws WriteError with the
-// path and the cause: no such folder, a directory, no permission, a read-only file system.
+// path and the cause: no such folder, not a regular file, no permission, a read-only file
+// system.
 void check_writable(const std::string& path);
 
 }  // namespace fem

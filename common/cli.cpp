@@ -243,8 +243,10 @@ SolverSettings solver_from_args(const ArgParser& args) {
 
 void add_thread_option(ArgParser& args) {
   args.option("threads", "N",
-              "threads of the parallel chapters, 09 on (default: OMP_NUM_THREADS, else all " +
-                  std::to_string(hardware_threads()) + ")",
+              "threads of the parallel chapters, 09 on: the count every step runs on (default: "
+              "OMP_NUM_THREADS, else the steppers choose: one thread below 20000 nodes, else "
+              "all " +
+                  std::to_string(hardware_threads()) + ", or one while that is faster)",
               "");
 }
 
@@ -259,6 +261,8 @@ void apply_thread_environment() {
 
 std::vector<int> thread_counts_from_args(const ArgParser& args, const std::string& name) {
   std::vector<int> counts = args.get_int_list(name);
+  if (counts.empty() && args.given(name))  // --threads "" or ",": a list that names none
+    throw UsageError("--" + name + " '" + args.get(name) + "' names no thread count");
   if (counts.empty()) {
     apply_thread_environment();  // OMP_NUM_THREADS, held to the rule of --threads
     counts = max_threads() > 1 ? std::vector<int>{1, max_threads()} : std::vector<int>{1};
@@ -275,7 +279,8 @@ std::vector<int> thread_counts_from_args(const ArgParser& args, const std::strin
 }
 
 int threads_from_args(const ArgParser& args) {
-  if (const std::string& value = args.get("threads"); !value.empty()) {
+  if (args.given("threads")) {
+    // An empty value is a mistake like any other, not "not given" (--threads "$N" unset).
     const int n = args.get_int("threads");
     try {
       if (const std::string warning = check_thread_count(n); !warning.empty())
@@ -284,8 +289,10 @@ int threads_from_args(const ArgParser& args) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--threads: ") + e.what());
     }
+    set_thread_count_asked(true);
   } else {
     apply_thread_environment();
+    set_thread_count_asked(thread_environment_count() > 0);
   }
   return max_threads();
 }

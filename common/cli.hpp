@@ -42,6 +42,8 @@ class ArgParser {
   int get_int(const std::string& name) const;        // throws UsageError if not an integer
   bool has_flag(const std::string& name) const;
   bool has_option(const std::string& name) const { return options_.count(name) > 0; }
+  // On the command line (with any value, "" included), not only its default.
+  bool given(const std::string& name) const { return options_.at(name).set; }
   // The option's comma-separated items, empty ones skipped: "09,,12" -> {"09", "12"}; "" -> {}.
   std::vector<std::string> get_list(const std::string& name) const;
   // The items as integers, a repeated one kept once (at its first place); throws UsageError
@@ -69,12 +71,14 @@ Scene scene_from_args(const ArgParser& args);
 void add_solver_options(ArgParser& args);
 SolverSettings solver_from_args(const ArgParser& args);
 
-// --threads N: the thread count of the parallel chapters (09 on). Without it OpenMP's own
-// rule holds: OMP_NUM_THREADS, or every hardware thread.
+// --threads N: the thread count of the parallel chapters (09 on). Without it OMP_NUM_THREADS;
+// without either the count is not asked for, and the steppers choose (common/threads.hpp).
 void add_thread_option(ArgParser& args);
-// Applies --threads when given; returns the thread count in use. Throws UsageError for a
-// count below 1, above 1 in a build without OpenMP, or above thread_limit() (common/threads.hpp);
-// warns on stderr above the hardware threads.
+// Applies --threads when given (or OMP_NUM_THREADS) and marks the count asked for
+// (set_thread_count_asked), so that it is the count that steps; returns the thread count in
+// use. Throws UsageError for an empty value, a count below 1, above 1 in a build without
+// OpenMP, above OMP_THREAD_LIMIT or above thread_limit() (common/threads.hpp); warns on stderr
+// above the hardware threads.
 int threads_from_args(const ArgParser& args);
 // Without --threads: OMP_NUM_THREADS checked by the same rule (check_thread_environment):
 // throws UsageError above the limit, warns on stderr above the hardware threads.

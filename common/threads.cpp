@@ -38,6 +38,13 @@ void set_threads(int n) {
 #endif
 }
 
+namespace {
+thread_local bool asked_on_this_thread = false;
+}  // namespace
+
+bool thread_count_asked() { return asked_on_this_thread; }
+void set_thread_count_asked(bool asked) { asked_on_this_thread = asked; }
+
 int thread_limit() {
   const int hardware = static_cast<int>(std::thread::hardware_concurrency());
   return kOversubscription * (hardware > 0 ? hardware : 1);
@@ -48,6 +55,14 @@ std::string check_thread_count(int n) {
   if (n > 1 && !openmp_enabled())
     throw std::invalid_argument("this build has no OpenMP (FEM_OPENMP=OFF): only 1 thread, not " +
                                 std::to_string(n));
+#ifdef _OPENMP
+  // OMP_THREAD_LIMIT caps every team whatever is asked: a count above it would run on fewer
+  // threads than the program says and records.
+  if (const int cap = omp_get_thread_limit(); n > cap)
+    throw std::invalid_argument(std::to_string(n) + " threads, but OMP_THREAD_LIMIT allows " +
+                                std::to_string(cap) + ": unset it, or ask for at most " +
+                                std::to_string(cap));
+#endif
   const unsigned hardware = std::thread::hardware_concurrency();
   if (n > thread_limit())
     throw std::invalid_argument(
@@ -63,15 +78,20 @@ std::string check_thread_count(int n) {
   return "";
 }
 
-std::string check_thread_environment() {
+int thread_environment_count() {
   const char* value = std::getenv("OMP_NUM_THREADS");
-  if (!value) return "";
+  if (!value) return 0;
   char* end = nullptr;
   const long n = std::strtol(value, &end, 10);  // "4,2" (nested levels): the outer count
-  if (end == value || n < 1 || n > 1 << 20) return "";
-  const std::string name = std::string("OMP_NUM_THREADS=") + value;
+  return end == value || n < 1 || n > 1 << 20 ? 0 : static_cast<int>(n);
+}
+
+std::string check_thread_environment() {
+  const int n = thread_environment_count();
+  if (n == 0) return "";
+  const std::string name = std::string("OMP_NUM_THREADS=") + std::getenv("OMP_NUM_THREADS");
   try {
-    const std::string warning = check_thread_count(static_cast<int>(n));
+    const std::string warning = check_thread_count(n);
     return warning.empty() ? "" : name + ": " + warning;
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(name + ": " + e.what() +

@@ -42,6 +42,8 @@ std::string check_thread_count(int n);
 // variable above thread_limit(), returns the warning above the hardware threads, "" when the
 // variable is unset (or not a count, which OpenMP ignores too).
 std::string check_thread_environment();
+// The count OMP_NUM_THREADS asks for (its first number), 0 when unset or not a count.
+int thread_environment_count();
 
 // Sets the thread count for a scope and restores the previous one: tests, benchmarks.
 class ThreadCountScope {
@@ -53,6 +55,26 @@ class ThreadCountScope {
 
  private:
   int previous_;
+};
+
+// Whether the thread count in force was asked for (--threads N, OMP_NUM_THREADS, a Body's
+// `threads`): then it is the count that steps, and a team that would choose its own size
+// (chapter 09's AdaptiveTeam, which takes one thread while that is faster) keeps it. Per
+// thread, as OpenMP's count is: set_thread_count_asked for the thread that calls it (a
+// program's main thread), AskedThreadsScope for one step (the library's Body).
+bool thread_count_asked();
+void set_thread_count_asked(bool asked);
+class AskedThreadsScope {
+ public:
+  explicit AskedThreadsScope(bool asked) : previous_(thread_count_asked()) {
+    set_thread_count_asked(asked);
+  }
+  ~AskedThreadsScope() { set_thread_count_asked(previous_); }
+  AskedThreadsScope(const AskedThreadsScope&) = delete;
+  AskedThreadsScope& operator=(const AskedThreadsScope&) = delete;
+
+ private:
+  bool previous_;
 };
 
 // One thread for a scope, OpenMP's and Eigen's own (Eigen::setNbThreads), both restored at

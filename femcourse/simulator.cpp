@@ -19,6 +19,8 @@ namespace femcourse {
 inline namespace FEMCOURSE_ABI {
 namespace {
 
+constexpr int kMostSubsteps = 1000;  // more is a typo: a step() of a thousand steps' cost
+
 [[noreturn]] void refuse(const std::string& problem) {
   throw std::invalid_argument("femcourse::Body: " + problem);
 }
@@ -109,7 +111,9 @@ fem::Scene scene_of(const BodyDescription& d, fem::TetMesh mesh) {
   scene.name = "body";
   scene.material = {d.youngs_modulus, d.poisson_ratio, d.density};
   scene.damping = {d.damping_alpha, d.damping_beta};
-  scene.dt = d.time_step;
+  if (d.substeps < 1 || d.substeps > kMostSubsteps)
+    refuse("substeps is " + std::to_string(d.substeps) + ": 1 to " + std::to_string(kMostSubsteps));
+  scene.dt = d.time_step / d.substeps;
   scene.gravity = vector_of(d.gravity);
   for (const Constraint& c : d.constraints)
     scene.constraints.push_back(constraint_of(c, mesh.num_nodes()));
@@ -121,6 +125,11 @@ fem::Scene scene_of(const BodyDescription& d, fem::TetMesh mesh) {
 fem::SolverSettings solver_of(const BodyDescription& d) {
   if (!(d.solver_tolerance > 0.0) || d.solver_max_iterations <= 0)
     refuse("solver_tolerance and solver_max_iterations must be positive");
+  // At 1 or more the solve stops before its first iteration (||r|| <= ||b|| at the start):
+  // the body would never move, silently.
+  if (!(d.solver_tolerance < 1.0))
+    refuse("solver_tolerance is " + std::to_string(d.solver_tolerance) +
+           ": it must lie in (0, 1) (at 1 or more CG stops before its first iteration)");
   return {d.solver_tolerance, d.solver_max_iterations};
 }
 
@@ -185,6 +194,9 @@ struct Body::Impl {
   fem::Scene scene;  // first: the stepper is built from it and may keep a reference
   StepperFactory make;
   std::unique_ptr<fem::Stepper> stepper;
+  // The chapter's record of what its stepper ran (chapters/work.hpp): the team of a step.
+  fem::ExecutedWork (*executed)(const fem::Stepper&) = nullptr;
+  int threads_used = 0;  // the last step's team
   fem::State state;
   Eigen::VectorXd previous_v;  // before the last step: the reactions' dv
   fem::SolverSettings solver;
@@ -192,8 +204,10 @@ struct Body::Impl {
   bool forces_set = false;                 // set_forces was called: forces replace the scene's
   StepProfile profile;
   std::string chapter;
-  long long steps = 0;
-  int threads = 0;  // as asked: 0 automatic
+  long long steps = 0;  // step() calls
+  int substeps = 1;
+  bool warned_impact = false;  // the floor's inverting impact, reported once
+  int threads = 0;             // as asked: 0 automatic
   // The constraints are composed from three sources (compose_constraints).
   std::vector<fem::NodeConstraint> own;  // the description's, for the body's life
   std::vector<int> grabbed;
@@ -203,10 +217,16 @@ struct Body::Impl {
   std::vector<int> contacts;
   std::vector<char> owned;  // per node: has a constraint of its own
   std::vector<std::array<int, 3>> surface;
-  // The forces' model, made on first need (reactions, the floor, elastic_forces).
+  // The forces' model, made on first need (reactions, the floor, elastic_forces), and its
+  // forces at the positions of one state: a force pass each time the positions change, shared
+  // by every read-out of that state (the floor's release test, reactions, elastic_forces).
   mutable std::unique_ptr<fem::Model> model;
   mutable std::vector<Eigen::Matrix3d> rotations;
   mutable Eigen::VectorXd f_model;
+  long long positions_version = 0;  // counts the changes of state.x
+  mutable long long f_model_version = -1;
+  mutable std::vector<NodeForce> reactions_out;  // the read-outs' storage, reused
+  mutable std::vector<double> elastic_out;
   mutable std::unique_ptr<fem::DeformationProbe> probe;
   std::function<void(const std::string&)> warning_handler;
   std::deque<std::string> warnings;
@@ -237,8 +257,23 @@ struct Body::Impl {
   void replace_contacts(std::vector<int> next);
   const Eigen::VectorXd& model_forces() const;  // elastic + gravity at state.x
   Eigen::Vector3d reaction(int node) const;
+  void sub_step();
   void update_floor();
+  void warn_if_impact_inverts();
+  void check_restorable(const BodyState& saved) const;
   static void receive_warning(void* self, const std::string& message);
+  // Inside the step's thread scope: the team its stepper recorded, else the count in force
+  // for a stepper that threads without saying, else one.
+  int team_of_last_step() const {
+    const double team = executed ? executed(*stepper).team : 0.0;
+    if (team > 0.0) return static_cast<int>(team);
+    return stepper->uses_threads() ? fem::max_threads() : 1;
+  }
+  void set_floor(bool on, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+    floor_on = on;
+    floor_point = point;
+    floor_normal = normal;
+  }
 };
 
 std::vector<fem::NodeConstraint> Body::Impl::compose_constraints() const {
@@ -290,7 +325,10 @@ const Eigen::VectorXd& Body::Impl::model_forces() const {
     rotations.resize(scene.mesh.tets.size());
     f_model.resize(model->dofs);
   }
-  fem::compute_rotations_and_forces(*model, state.x, rotations, f_model);
+  if (f_model_version != positions_version) {
+    fem::compute_rotations_and_forces(*model, state.x, rotations, f_model);
+    f_model_version = positions_version;
+  }
   return f_model;
 }
 
@@ -311,7 +349,7 @@ Eigen::Vector3d Body::Impl::reaction(int node) const {
 // below it are put on it with their velocity into it removed.
 void Body::Impl::update_floor() {
   if (!floor_on) return;
-  bool changed = false;
+  bool changed = false, landed = false;
   if (!contacts.empty()) {
     model_forces();
     const auto pulling = [&](int node) { return reaction(node).dot(floor_normal) < 0.0; };
@@ -327,12 +365,30 @@ void Body::Impl::update_floor() {
         std::find(contacts.begin(), contacts.end(), node) != contacts.end())
       continue;
     x -= depth * floor_normal;
+    ++positions_version;
     auto v = state.v.segment<3>(3 * node);
     v -= std::min(0.0, floor_normal.dot(v)) * floor_normal;
     contacts.push_back(node);
-    changed = true;
+    changed = landed = true;
   }
   if (changed) apply_constraints(compose_constraints());
+  if (landed) warn_if_impact_inverts();
+}
+
+// An impact the step was too long for: the nodes put on the floor squash the elements above
+// them inside out. Checked on the steps that put nodes on the floor only (a pass over the
+// elements), and said once.
+void Body::Impl::warn_if_impact_inverts() {
+  if (warned_impact) return;
+  if (!probe) probe = std::make_unique<fem::DeformationProbe>(scene);
+  const fem::DeformationCheck c = probe->check(state);
+  if (c.inverted == 0) return;
+  warned_impact = true;
+  receive_warning(this, "femcourse::Body: step " + std::to_string(steps) + ": " +
+                            std::to_string(c.inverted) + " of " + std::to_string(c.elements) +
+                            " elements inverted as the body hit the floor (reported once): "
+                            "raise BodyDescription::substeps (now " +
+                            std::to_string(substeps) + "), or shorten time_step");
 }
 
 void Body::Impl::receive_warning(void* self, const std::string& message) {
@@ -353,14 +409,17 @@ Body::Body(const BodyDescription& d, const StepperFactory& make_stepper) {
   } else {
     const fem::ChapterInfo& info = chapter_of(d.chapter);
     impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
+    impl_->executed = info.work.executed;
   }
   impl_->threads = d.threads;
+  impl_->substeps = d.substeps;
 }
 
 Body::Body(fem::Scene scene, const fem::SolverSettings& solver, const std::string& chapter) {
   fem::validate(scene);
   const fem::ChapterInfo& info = chapter_of(chapter);
   impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
+  impl_->executed = info.work.executed;
 }
 
 Body::~Body() = default;
@@ -379,13 +438,24 @@ const Body::Impl& Body::impl() const {
 
 void Body::step() {
   Impl& b = impl();
+  ++b.steps;
+  for (int k = 0; k < b.substeps; ++k) b.sub_step();
+}
+
+void Body::Impl::sub_step() {
+  Impl& b = *this;
   b.previous_v = b.state.v;
   {
-    const StepThreads team(b.threads > 0 ? b.threads : num_nodes() < kSmallBodyNodes ? 1 : 0);
+    const StepThreads team(b.threads > 0                              ? b.threads
+                           : scene.mesh.num_nodes() < kSmallBodyNodes ? 1
+                                                                      : 0);
+    // An asked count is the one that steps: no adaptive team below it (common/threads.hpp).
+    const fem::AskedThreadsScope asked(b.threads > 0);
     const fem::WarningSinkScope sink(&Impl::receive_warning, &b);
     b.stepper->step(b.state);
+    ++b.positions_version;
+    b.threads_used = b.team_of_last_step();
   }
-  ++b.steps;
   const fem::StepProfile& p = b.stepper->profile();
   b.profile = {p.forces.seconds,    p.dfdx.seconds, p.compose.seconds,  p.constraints.seconds,
                p.solve.seconds,     p.step.seconds, p.step.allocations, p.cg_iterations,
@@ -420,7 +490,9 @@ std::array<double, 3> Body::position(int node) const {
   return {x[0], x[1], x[2]};
 }
 
-double Body::time() const { return static_cast<double>(impl().steps) * impl().scene.dt; }
+double Body::time() const {
+  return static_cast<double>(impl().steps) * impl().substeps * impl().scene.dt;
+}
 const StepProfile& Body::profile() const { return impl().profile; }
 const std::string& Body::chapter() const { return impl().chapter; }
 
@@ -432,10 +504,12 @@ void Body::set_chapter(const std::string& chapter) {
   // Nothing above changed the body: from here on nothing throws.
   b.stepper = std::move(next);
   b.make = info.make;
+  b.executed = info.work.executed;
   b.chapter = info.id;
 }
 
 int Body::threads() const { return impl().threads; }
+int Body::threads_used() const { return impl().threads_used; }
 
 void Body::set_threads(int threads) {
   Impl& b = impl();
@@ -482,9 +556,11 @@ void Body::set_floor(const std::array<double, 3>& point, const std::array<double
   const Eigen::Vector3d p = vector_of(point), n = vector_of(normal);
   if (!p.allFinite() || !n.allFinite() || !(n.norm() > 0.0))
     refuse("set_floor: the point and the normal must be finite, the normal not zero");
-  b.floor_on = true;
-  b.floor_point = p;
-  b.floor_normal = n.normalized();
+  // A floor moved or tilted under a resting body lets its contacts go: the next step finds
+  // them against the new plane (held on the old one, they would stay where it was).
+  const bool moved = b.floor_on && (p != b.floor_point || n.normalized() != b.floor_normal);
+  if (moved && !b.contacts.empty()) b.replace_contacts({});
+  b.set_floor(true, p, n.normalized());
 }
 
 void Body::remove_floor() {
@@ -497,21 +573,24 @@ const std::vector<int>& Body::floor_contacts() const { return impl().contacts; }
 bool Body::changes_constraints_in_place() const { return impl().stepper->can_change_constraints(); }
 const std::vector<std::array<int, 3>>& Body::surface() const { return impl().surface; }
 
-std::vector<NodeForce> Body::reactions() const {
+const std::vector<NodeForce>& Body::reactions() const {
   const Impl& b = impl();
   b.model_forces();
-  std::vector<NodeForce> out;
+  b.reactions_out.clear();  // keeps its capacity
   for (const fem::NodeConstraint& c : b.scene.constraints) {
     const Eigen::Vector3d r = b.reaction(c.node);
-    out.push_back({c.node, {r[0], r[1], r[2]}});
+    b.reactions_out.push_back({c.node, {r[0], r[1], r[2]}});
   }
-  return out;
+  return b.reactions_out;
 }
 
-std::vector<double> Body::elastic_forces() const {
+const std::vector<double>& Body::elastic_forces() const {
   const Impl& b = impl();
-  const Eigen::VectorXd elastic = b.model_forces() - b.model->gravity_force;
-  return {elastic.data(), elastic.data() + elastic.size()};
+  const Eigen::VectorXd& forces = b.model_forces();  // makes the model: before its gravity
+  b.elastic_out.resize(static_cast<std::size_t>(forces.size()));
+  Eigen::Map<Eigen::VectorXd>(b.elastic_out.data(), forces.size()) =
+      forces - b.model->gravity_force;
+  return b.elastic_out;
 }
 
 DeformationStatus Body::check_deformation() const {
@@ -539,24 +618,77 @@ BodyState Body::save_state() {
   Impl& b = impl();
   b.restart_stepper();
   const fem::State& s = b.state;
+  const auto array = [](const Eigen::Vector3d& v) {
+    return std::array<double, 3>{v[0], v[1], v[2]};
+  };
   return {{s.x.data(), s.x.data() + s.x.size()},
           {s.v.data(), s.v.data() + s.v.size()},
           b.steps,
-          b.contacts};
+          b.contacts,
+          b.floor_on,
+          array(b.floor_point),
+          array(b.floor_normal)};
+}
+
+namespace {
+
+bool all_finite(const std::vector<double>& values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+// Everything checked before anything changes, each refusal in the state's own terms (the
+// caller's node numbers, not the stepper's).
+void Body::Impl::check_restorable(const BodyState& saved) const {
+  const auto values = static_cast<std::size_t>(state.x.size());
+  const int nodes = scene.mesh.num_nodes();
+  if (saved.positions.size() != values || saved.velocities.size() != values)
+    refuse("restore_state: the state holds " + std::to_string(saved.positions.size()) +
+           " position and " + std::to_string(saved.velocities.size()) +
+           " velocity values, the body needs " + std::to_string(values) + " of each (3 per node, " +
+           std::to_string(nodes) + " nodes)");
+  if (!all_finite(saved.positions) || !all_finite(saved.velocities))
+    refuse("restore_state: the state holds a NaN or infinite position or velocity");
+  if (!saved.floor && !saved.floor_contacts.empty())
+    refuse("restore_state: the state holds " + std::to_string(saved.floor_contacts.size()) +
+           " floor contacts but no floor (BodyState::floor is false): give its floor, or no "
+           "contacts");
+  const Eigen::Vector3d normal = vector_of(saved.floor_normal);
+  if (saved.floor &&
+      (!vector_of(saved.floor_point).allFinite() || !normal.allFinite() || !(normal.norm() > 0.0)))
+    refuse(
+        "restore_state: the state's floor point and normal must be finite, the normal not "
+        "zero");
+  std::vector<char> seen(static_cast<std::size_t>(nodes), 0);
+  for (const int node : saved.floor_contacts) {
+    check_node(node, nodes, "restore_state: a floor contact");
+    const auto n = static_cast<std::size_t>(node);
+    if (seen[n]++) refuse("restore_state: the floor contacts name " + node_name(node) + " twice");
+    if (owned[n] || is_grabbed(node))
+      refuse("restore_state: a floor contact names " + node_name(node) + ", which " +
+             (owned[n] ? "has a constraint of its own" : "is grabbed") +
+             ": the floor holds free nodes only");
+  }
 }
 
 void Body::restore_state(const BodyState& saved) {
   Impl& b = impl();
-  const auto values = static_cast<std::size_t>(b.state.x.size());
-  if (saved.positions.size() != values || saved.velocities.size() != values)
-    refuse("restore_state: the state holds " + std::to_string(saved.positions.size() / 3) +
-           " nodes, the body " + std::to_string(num_nodes()));
-  for (const int node : saved.floor_contacts)
-    check_node(node, num_nodes(), "restore_state: a floor contact");
-  b.replace_contacts(saved.floor_contacts);
+  b.check_restorable(saved);
+  const bool was_on = b.floor_on;
+  const Eigen::Vector3d point = b.floor_point, normal = b.floor_normal;
+  b.set_floor(saved.floor, vector_of(saved.floor_point),
+              saved.floor ? vector_of(saved.floor_normal).normalized() : normal);
+  try {
+    b.replace_contacts(saved.floor_contacts);
+  } catch (...) {
+    b.set_floor(was_on, point, normal);
+    throw;
+  }
   b.restart_stepper();  // as save_state did: no history of the steps since
   b.state.x = Eigen::Map<const Eigen::VectorXd>(saved.positions.data(), b.state.x.size());
   b.state.v = Eigen::Map<const Eigen::VectorXd>(saved.velocities.data(), b.state.v.size());
+  ++b.positions_version;
   b.previous_v = b.state.v;
   b.steps = saved.steps;
 }
@@ -568,6 +700,7 @@ void Body::set_state(const fem::State& state) {
            std::to_string(num_nodes()));
   b.state.x = state.x;
   b.state.v = state.v;
+  ++b.positions_version;
 }
 
 const fem::Scene& Body::scene() const { return impl().scene; }

@@ -81,12 +81,18 @@ struct BodyDescription {
   std::vector<Constraint> constraints;             // at most one per node
   std::array<double, 3> gravity{0.0, 0.0, -9.81};  // [m/s^2]
   double time_step = 0.01;                         // [s]
-  double solver_tolerance = 1e-4;                  // CG stops at ||r|| <= tolerance ||b||
+  // Each step() takes this many steps of time_step / substeps. The floor puts a penetrating
+  // node on its plane after a step, so a fast impact (a block dropped 2 m at 60 Hz) squashes
+  // and inverts elements for a few frames at 1; the body warns then, naming this setting.
+  int substeps = 1;
+  double solver_tolerance = 1e-4;  // CG stops at ||r|| <= tolerance ||b||, in (0, 1)
   int solver_max_iterations = 2000;
   std::string chapter;  // "12_half_the_bytes", "12", "half_the_bytes"; empty: the last chapter
-  // Threads that step this body (chapters 09 on; the earlier ones use one). 0: one thread
-  // below kSmallBodyNodes nodes, where a second thread gains little and another process on
-  // the machine turns each of its waits into a hitch; OpenMP's count above.
+  // Threads that step this body (chapters 09 on; the earlier ones use one): every step runs
+  // on exactly this many. 0 (not asked): one thread below kSmallBodyNodes nodes, where a
+  // second thread gains little and another process on the machine turns each of its waits
+  // into a hitch; above, OpenMP's count, or one thread while that is faster (chapter 09's
+  // adaptive team). threads_used() says what ran.
   int threads = 0;
 };
 constexpr int kSmallBodyNodes = 20000;
@@ -114,6 +120,10 @@ struct BodyState {
   std::vector<double> positions, velocities;  // 3 per node
   long long steps = 0;
   std::vector<int> floor_contacts;  // nodes held on the floor (set_floor)
+  // The floor the contacts are held on (set_floor's point and normal); restore_state puts it
+  // back, or removes the body's floor when the state has none.
+  bool floor = false;
+  std::array<double, 3> floor_point{0.0, 0.0, 0.0}, floor_normal{0.0, 0.0, 1.0};
 };
 
 // The deformation watch (fem_sim's): an element stretched to several times its rest size, or
@@ -136,8 +146,9 @@ class Body {
   Body(Body&&) noexcept;
   Body& operator=(Body&&) noexcept;
 
-  // One step of time_step. Throws StepDiverged if the step cannot be trusted; the state is then
-  // that of the failed step (restore_state() goes back to a saved one).
+  // One step of time_step (in `substeps` sub-steps). Throws StepDiverged if a sub-step cannot be
+  // trusted; the state is then that of the failed sub-step (restore_state() goes back to a
+  // saved one). profile() is the last sub-step's.
   void step();
   // Replaces the external forces (the mouse drag) from the next step on; {} removes them.
   // Throws std::invalid_argument for a missing node or a non-finite force.
@@ -156,6 +167,9 @@ class Body {
   void set_chapter(const std::string& chapter);
   int threads() const;
   void set_threads(int threads);  // as BodyDescription::threads
+  // The threads the last step ran on, as its team recorded them (not the count asked for):
+  // 1 for a single-threaded chapter; 0 before the first step.
+  int threads_used() const;
 
   // ---- interaction while it runs ---------------------------------------------------------
   // Each call below changes the body's constraints from the next step on. A chapter's stepper
@@ -173,7 +187,9 @@ class Body {
   // to where the body may go). A free node that ends a step below it is put on it, its
   // velocity into it removed, and held on it until the floor would have to pull it back (its
   // reaction points into the floor): then it is released. Nodes with constraints of their own
-  // or grabbed are left alone. Throws std::invalid_argument for a zero or non-finite normal.
+  // or grabbed are left alone. Called again (a moving or tilting platform), it lets the contacts
+  // go and the next step finds them against the new plane. Throws std::invalid_argument for a
+  // zero or non-finite normal.
   void set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal);
   void remove_floor();
   const std::vector<int>& floor_contacts() const;
@@ -186,9 +202,12 @@ class Body {
   // The forces that the constraints (own, grabbed, floor) exerted on their nodes in the last
   // step [N]: m dv/dt minus the elastic, gravity, external and mass-damping forces at the new
   // state (the stiffness damping left out). Summed over a support at rest, minus the loads.
-  std::vector<NodeForce> reactions() const;
+  // The read-outs below are callable in any order. They share one force pass per state (the
+  // floor's contacts make it anyway after a step), and their storage is the body's, reused:
+  // no allocation once it has held as many values; valid until the body changes.
+  const std::vector<NodeForce>& reactions() const;
   // The elastic forces on every node at the current positions [N], 3 * num_nodes() values.
-  std::vector<double> elastic_forces() const;
+  const std::vector<double>& elastic_forces() const;
   DeformationStatus check_deformation() const;
 
   // ---- diagnostics ------------------------------------------------------------------------
@@ -200,7 +219,9 @@ class Body {
   // preconditioner), so that from then on the saved state alone decides every step: a body
   // restored to it steps bit-identically to the body that saved it. Costs a construction.
   BodyState save_state();
-  // Throws std::invalid_argument for another number of nodes or a missing contact node.
+  // Throws std::invalid_argument, changing nothing, for another number of nodes, a NaN or
+  // infinite value, floor contacts without a floor, or a contact on a missing node, on a node
+  // named twice or on a node with a constraint of its own or grabbed.
   void restore_state(const BodyState& state);
 
   // ---- advanced: the course's own types (include "common/stepper.hpp") -----------------

@@ -19,6 +19,8 @@ import pathlib
 import sys
 import time
 
+from femtools.files import replacing, write_text
+
 HERE = pathlib.Path(__file__).resolve().parent
 
 # name: (box size x, y, z in metres, target mesh size, committed?)
@@ -57,7 +59,10 @@ def generate(gmsh, name, path):
     gmsh.option.setNumber("Mesh.MeshSizeMin", size)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.model.mesh.generate(3)
-    gmsh.write(str(path))
+    # Under a temporary name, renamed over the mesh once whole: gmsh writes in place, and a
+    # Ctrl-C (gmsh puts SIGINT back to its default) would leave a committed mesh cut.
+    with replacing(path) as tmp:
+        gmsh.write(str(tmp))
     tags, _ = gmsh.model.mesh.getElementsByType(4)
     _, nodes = gmsh.model.mesh.getElementsByType(4)
     return len(set(nodes.tolist())), len(tags)
@@ -157,7 +162,7 @@ def main():
             sys.exit(f"{readme} has no {begin} ... {end} markers")
         head, rest = text.split(begin, 1)
         _, tail = rest.split(end, 1)
-        readme.write_text(head + begin + "\n" + readme_table(rows, gmsh.__version__) + end + tail)
+        write_text(readme, head + begin + "\n" + readme_table(rows, gmsh.__version__) + end + tail)
         print(f"wrote the table in {readme}")
     gmsh.finalize()
 

@@ -25,6 +25,9 @@ struct ChapterResult {
   double relative_residual = 0.0;  // last step
   int not_converged_steps = 0;
   int threads = 1;  // the thread count of the run: 1 for the single-threaded chapters
+  // The threads the measured steps ran on, by the stepper's own record (chapter 09's adaptive
+  // team takes one thread while that is faster); 0 where the chapter does not say.
+  int threads_fewest = 0, threads_most = 0;
 };
 
 // Runs the chapters interleaved, Schedule::turn steps of each in turn: when the machine's

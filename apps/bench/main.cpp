@@ -33,9 +33,17 @@ std::vector<SolverResult> solve_tables(const Scene& scene, const BenchOptions& o
 
 extern "C" void request_stop(int) { interrupted = 1; }
 
+void install_stop_handlers() {
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
+}
+
 // The measurements and their JSON, after the checks and the lock of run_bench.
 int measure_and_write(const ArgParser& args, const BenchOptions& options, bool replacing) {
   const Scene scene = scene_from_args(args);
+  // Again after the mesh load: the gmsh reader's initialisation can put SIGTERM back to its
+  // default, and a batch system's SIGTERM would then end the run with no word and its lock.
+  install_stop_handlers();
   if (!options.json.empty()) check_writable(options.json);
   const SourceState source = source_state();
   print_setup(scene, options, source);
@@ -70,8 +78,7 @@ int run_bench(const ArgParser& args) {
   const std::optional<RunLock> lock = lock_run_folder(options);
   const bool replacing = !options.json.empty() && std::filesystem::exists(options.json);
   if (replacing && !options.replace) throw UsageError(holds_a_run(options.json));
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
+  install_stop_handlers();
   try {
     return measure_and_write(args, options, replacing);
   } catch (const Interrupted&) {

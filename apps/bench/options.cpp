@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "apps/bench/run_folder.hpp"
+#include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
 
@@ -98,8 +99,9 @@ BenchOptions bench_options(const ArgParser& args) {
   o.verbose = args.has_flag("verbose");
   if (!o.json.empty() && !o.json_named && args.get("out").empty())
     o.latest = std::filesystem::path(o.json).parent_path().filename().string();
-  if (!o.replace && !o.json.empty() && std::filesystem::exists(o.json))
-    throw UsageError(holds_a_run(o.json));
+  const bool not_a_file = !o.json.empty() && !not_a_regular_file(o.json).empty();
+  if (not_a_file || (!o.replace && !o.json.empty() && std::filesystem::exists(o.json)))
+    throw UsageError(holds_a_run(o.json));  // a device or a FIFO even with --replace
   o.solve_tables = !args.has_flag("no-solvers");
   return o;
 }

@@ -69,6 +69,7 @@ Json chapter_json(const ChapterResult& r) {
   c["relative_residual"] = r.relative_residual;
   c["not_converged_steps"] = r.not_converged_steps;
   c["threads"] = r.threads;
+  if (r.threads_most > 0) c["threads_ran"] = {r.threads_fewest, r.threads_most};
   return c;
 }
 

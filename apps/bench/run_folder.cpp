@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "common/atomic_file.hpp"
 #include "common/cli.hpp"
 
 namespace fem::bench {
@@ -20,7 +21,8 @@ void check_writable(const std::string& path) {
       throw UsageError("cannot write the results into '" + dir.string() +
                        "': " + (error ? error.message() : "not a directory"));
   }
-  if (fs::is_directory(file)) throw UsageError(holds_a_run(path));
+  // A device or a FIFO: refused before the open below, which would replace or block on it.
+  if (!not_a_regular_file(path).empty()) throw UsageError(holds_a_run(path));
   const bool existed = fs::exists(file);
   if (!std::ofstream(file, std::ios::app))
     throw UsageError("cannot write '" + path + "' (permissions?)");
@@ -52,6 +54,9 @@ std::string holds_a_run(const std::string& json) {
   if (fs::is_directory(json))
     return "'" + json + "' is a directory, not a JSON file: give a file (--json " +
            (fs::path(json) / "bench.json").string() + "), or the folder as --out " + json;
+  // A device or a FIFO holds no run, and --replace would replace the node itself.
+  if (const std::string cause = not_a_regular_file(json); !cause.empty())
+    return "--json '" + json + "': " + cause + ", or --no-json to print the tables only";
   return "'" + json +
          "' holds an earlier run: give another --out (or --json), or --replace to replace it "
          "and its plots";

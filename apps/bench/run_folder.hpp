@@ -21,8 +21,9 @@ void check_writable(const std::string& path);
 // that holds it.
 std::optional<RunLock> lock_run_folder(const BenchOptions& options);
 
-// "'PATH' holds an earlier run: ...": the refusal without --replace; for a directory given as
-// --json, that it is one (--replace, which that refusal suggests, cannot help there).
+// "'PATH' holds an earlier run: ...": the refusal without --replace; for a directory, a device
+// or a FIFO given as --json, what it is (--replace, which that refusal suggests, cannot help
+// there, and would replace a device).
 std::string holds_a_run(const std::string& json);
 
 // results/latest -> results/FOLDER (a relative symbolic link), the convention for "the newest

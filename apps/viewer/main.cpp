@@ -116,9 +116,14 @@ void write_report(std::ostream& out, const RunRecord& r, const fv::Session& sess
   const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const fem::BuildInfo build = fem::build_info();
   out << "{\n  \"chapter\": " << fem::json_string(session.chapter())
-      << ",\n  \"mesh\": " << fem::json_string(session.scene().mesh.file)
-      << ",\n  \"nodes\": " << session.scene().mesh.num_nodes()
-      << ",\n  \"threads\": " << (session.uses_threads() ? fem::max_threads() : 1)
+      << ",\n  \"mesh\": " << fem::json_string(session.scene().mesh.file) << ",\n  \"nodes\": "
+      << session.scene().mesh.num_nodes()
+      // The stepper's own record of the steps (the most and the fewest threads a step ran
+      // on: an adaptive team may take one), and the count asked for (0: none, the library's
+      // choice).
+      << ",\n  \"threads\": " << session.threads_ran().second
+      << ",\n  \"threads_fewest\": " << session.threads_ran().first
+      << ",\n  \"threads_asked\": " << session.settings().threads
       << ",\n  \"paused\": " << (r.paused ? "true" : "false") << ",\n  \"width\": " << r.width
       << ",\n  \"height\": " << r.height
       << ",\n  \"renderer\": " << fem::json_string(renderer ? renderer : "unknown")
@@ -281,7 +286,9 @@ void report_run(const RunRecord& record, const fv::Session& session, const Optio
   std::cout << "fem_viewer: " << record.frames << " frames in " << record.seconds << " s ("
             << record.frames / std::max(record.seconds, 1e-9) << " frames/s), chapter "
             << session.chapter() << ", mean step "
-            << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1) << " ms\n";
+            << 1e3 * record.step_seconds / std::max<long long>(record.steps, 1)
+            << " ms, threads the steps ran on: " << session.threads_ran().first << "-"
+            << session.threads_ran().second << "\n";
   if (!options.report.empty()) {
     fem::write_file_atomically(options.report,
                                [&](std::ostream& out) { write_report(out, record, session); });
@@ -411,10 +418,13 @@ int run_viewer(const fem::ArgParser& args) {
   settings.damping = scene.damping;
   settings.dt = scene.dt;
   settings.solver = solver_from_args(args);
+  settings.threads = thread_count_asked() ? threads : 0;
   auto session = std::make_unique<fv::Session>(scene.mesh, settings, options.chapter);
   std::cout << "fem_viewer: " << scene.name << " on " << scene.mesh.file << " ("
-            << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", " << threads
-            << " threads for the parallel chapters\n";
+            << scene.mesh.num_nodes() << " nodes), chapter " << options.chapter << ", "
+            << (settings.threads > 0 ? std::to_string(threads) + " threads asked"
+                                     : std::string("threads not asked (the library's choice)"))
+            << " for the parallel chapters\n";
   const Window window(options);
   run(window.handle, session, options);
   return 0;

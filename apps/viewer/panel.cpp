@@ -7,7 +7,6 @@
 
 #include "apps/viewer/markers.hpp"
 #include "chapters/registry.hpp"
-#include "common/threads.hpp"
 
 namespace fem::viewer {
 
@@ -139,8 +138,11 @@ void draw_panel(const Session& session, double frames_per_second, PanelState& st
               session.steps());
   chapter_list(session, state);
   // Chapters before 09 use one thread whatever the count (--threads or OMP_NUM_THREADS).
-  ImGui::Text("threads: %d %s", session.uses_threads() ? max_threads() : 1,
-              session.uses_threads() ? "(OpenMP)" : "(this chapter is single-threaded)");
+  // The last steps' teams as the stepper recorded them, not the option.
+  ImGui::Text("threads: %d-%d %s", session.threads_ran().first, session.threads_ran().second,
+              !session.uses_threads()      ? "(this chapter is single-threaded)"
+              : session.settings().threads ? "(asked)"
+                                           : "(the library's choice)");
   ImGui::Separator();
   phase_bars(session);
   ImGui::Separator();

@@ -33,7 +33,14 @@ Session::Session(TetMesh mesh, const SessionSettings& settings, const std::strin
     : settings_(settings),
       body_(build_scene(settings, std::move(mesh)), settings.solver, find_chapter(chapter).id),
       chapter_(body_.chapter()) {
+  if (settings.threads > 0) body_.set_threads(settings.threads);
   measure_body();
+}
+
+femcourse::Body Session::make_body(const Scene& scene, const SolverSettings& solver) const {
+  femcourse::Body body(scene, solver, chapter_);
+  if (settings_.threads > 0) body.set_threads(settings_.threads);  // the asked count steps
+  return body;
 }
 
 void Session::measure_body() {
@@ -56,7 +63,7 @@ void Session::set_chapter(const std::string& chapter) {
 void Session::apply(const SessionSettings& settings) {
   const bool restart = settings.scene != settings_.scene;
   // Throws before anything changes.
-  femcourse::Body next(build_scene(settings, body_.scene().mesh), settings.solver, chapter_);
+  femcourse::Body next = make_body(build_scene(settings, body_.scene().mesh), settings.solver);
   next.set_state(body_.state());
   settings_ = settings;
   body_ = std::move(next);
@@ -66,9 +73,10 @@ void Session::apply(const SessionSettings& settings) {
 }
 
 void Session::reset() {
-  body_ = femcourse::Body(body_.scene(), settings_.solver, chapter_);  // forgets the warm start
+  body_ = make_body(body_.scene(), settings_.solver);  // forgets the warm start
   time_ = 0.0;
   steps_ = 0;
+  fewest_threads_ = most_threads_ = 0;
   grab_.reset();
   history_.clear();
 }
@@ -91,6 +99,9 @@ bool Session::step() {
   }
   time_ += body_.scene().dt;
   ++steps_;
+  const int team = body_.threads_used();
+  fewest_threads_ = fewest_threads_ == 0 ? team : std::min(fewest_threads_, team);
+  most_threads_ = std::max(most_threads_, team);
   history_.push_back(body_.stepper().profile());
   if (history_.size() > kHistory) history_.pop_front();
   return true;

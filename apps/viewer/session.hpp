@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -25,6 +26,7 @@ struct SessionSettings {
   double dt = 0.01;
   SolverSettings solver;
   double spring = 10.0;  // the mouse spring's relative stiffness, see spring_stiffness()
+  int threads = 0;       // asked for (--threads): every step runs on it; 0: the library's choice
 };
 
 // The mouse spring: pulls a surface node towards a target point. The force acts on the
@@ -74,6 +76,9 @@ class Session {
   const std::string& chapter() const { return chapter_; }
   const StepProfile& last_profile() const { return body_.stepper().profile(); }
   bool uses_threads() const { return body_.stepper().uses_threads(); }
+  // The threads the steps since the start (or the last reset) ran on, as the stepper's team
+  // recorded them: {fewest, most}; {0, 0} before the first step.
+  std::pair<int, int> threads_ran() const { return {fewest_threads_, most_threads_}; }
   // The profiles of the last steps (oldest first), for averages and plots.
   const std::deque<StepProfile>& history() const { return history_; }
   StepProfile mean_profile() const;
@@ -86,6 +91,7 @@ class Session {
 
  private:
   void measure_body();
+  femcourse::Body make_body(const Scene& scene, const SolverSettings& solver) const;
 
   SessionSettings settings_;
   femcourse::Body body_;  // the scene, the chapter's stepper and the state (the library's API)
@@ -100,6 +106,7 @@ class Session {
   std::deque<StepProfile> history_;
   double time_ = 0.0;
   long long steps_ = 0;
+  int fewest_threads_ = 0, most_threads_ = 0;
   std::string message_;
 };
 

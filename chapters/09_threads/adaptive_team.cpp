@@ -4,11 +4,13 @@
 #include <algorithm>
 
 #include "common/statistics.hpp"
+#include "common/threads.hpp"
 
 namespace fem::ch09 {
 
 int AdaptiveTeam::next(int given) {
-  chosen_ = enabled_ && given > 1;
+  // A count the user asked for is the one that steps (common/threads.hpp): no choice then.
+  chosen_ = enabled_ && given > 1 && !thread_count_asked();
   probing_ = false;
   if (!chosen_) return team_ = given;  // nothing to choose: record() ignores this step
   if (given != given_) {               // a new count from the program: start over with it

@@ -23,7 +23,8 @@ namespace fem::ch09 {
 
 class AdaptiveTeam {
  public:
-  // The team of the next step, given the program's thread count (OpenMP's).
+  // The team of the next step, given the program's thread count (OpenMP's): that count
+  // itself when it was asked for (common/threads.hpp's thread_count_asked).
   int next(int given);
   // The time of the step that ran with next()'s team.
   void record(double seconds);

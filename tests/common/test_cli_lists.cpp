@@ -30,10 +30,18 @@ TEST_CASE("get_list skips empty items and get_int_list keeps a repeated count on
   CHECK_THROWS_AS(parsed("1,x").get_int_list("list"), UsageError);
 }
 
-TEST_CASE("a thread-count list is checked as --threads is, and empty means 1 and OpenMP's") {
+TEST_CASE("a thread-count list is checked as --threads is, and none given means 1 and OpenMP's") {
   CHECK(thread_counts_from_args(parsed("1,1"), "list") == std::vector<int>{1});
   CHECK_THROWS_AS(thread_counts_from_args(parsed("0"), "list"), UsageError);
-  const std::vector<int> defaults = thread_counts_from_args(parsed(""), "list");
+  // Given but naming no count (--threads "$N" with N unset) is a mistake, not the default.
+  CHECK_THROWS_WITH(thread_counts_from_args(parsed(""), "list"),
+                    test::contains_text("--list '' names no thread count"));
+  CHECK_THROWS_AS(thread_counts_from_args(parsed(","), "list"), UsageError);
+  ArgParser not_given("test", "list options");
+  not_given.option("list", "LIST", "a list", "");
+  const char* argv[] = {"test"};
+  not_given.parse(1, argv);
+  const std::vector<int> defaults = thread_counts_from_args(not_given, "list");
   CHECK(defaults.front() == 1);
   CHECK(defaults.back() == max_threads());
 }

@@ -100,20 +100,23 @@ def bench_cases(bench, tmp):
 
 
 def bench_interrupted_case(base, folder, tmp):
-    """Ctrl-C during --replace: the run stops after its step with a message, exit 130, the
-    earlier bench.json byte-identical and no lock file left (it died silently, its lock left)."""
+    """Ctrl-C (or a batch system's SIGTERM, while it measures: after the mesh load, which can
+    reset its handler) during --replace: the run stops after its step with a message, exit
+    130, the earlier bench.json byte-identical and no lock file left (it died silently, its
+    lock left)."""
     before = snapshot(folder)
-    with open(tmp / "bench_interrupted.log", "w") as log:
-        p = holder(base + ["--steps", "1000000", "--out", folder, "--replace"], log)
-        started = wait_for(tmp / "bench_interrupted.log", "steps of each in turn")
-        p.send_signal(signal.SIGINT)
-        code = p.wait(timeout=120)
-    text = (tmp / "bench_interrupted.log").read_text()
-    check("fem_bench: Ctrl-C during --replace stops with a message, exit 130",
-          started and code == 130 and "stopped (Ctrl-C or SIGTERM) before the results" in text
-          and "is as it was" in text, f"exit {code}: {text}")
-    check("fem_bench: ... the earlier run byte-identical, the lock released",
-          snapshot(folder) == before, sorted(snapshot(folder)))
+    for name, sig in [("Ctrl-C", signal.SIGINT), ("SIGTERM", signal.SIGTERM)]:
+        with open(tmp / "bench_interrupted.log", "w") as log:
+            p = holder(base + ["--steps", "1000000", "--out", folder, "--replace"], log)
+            started = wait_for(tmp / "bench_interrupted.log", "steps of each in turn")
+            p.send_signal(sig)
+            code = p.wait(timeout=120)
+        text = (tmp / "bench_interrupted.log").read_text()
+        check(f"fem_bench: {name} during --replace stops with a message, exit 130",
+              started and code == 130 and "stopped (Ctrl-C or SIGTERM) before the results" in text
+              and "is as it was" in text, f"exit {code}: {text}")
+        check(f"fem_bench: ... the earlier run byte-identical, the lock released",
+              snapshot(folder) == before, sorted(snapshot(folder)))
 
 
 def sim_cases(sim, tmp):

@@ -20,6 +20,9 @@ def replacing(path):
     """
     path = pathlib.Path(path)
     tmp = path.with_name(f".{path.stem}.tmp{os.getpid()}{path.suffix}")
+    if path.exists() and not path.is_file():  # a device, a FIFO, a folder: the rename would replace it
+        sys.exit(f"cannot write '{path}': it is not a regular file (a device, a FIFO or a folder); "
+                 "give a file's path")
     try:
         yield tmp
         if os.environ.get("FEM_FAIL_WRITES") in ("*", path.name):
@@ -29,11 +32,20 @@ def replacing(path):
             os.fsync(f.fileno())
         os.replace(tmp, path)
     except OSError as e:
-        tmp.unlink(missing_ok=True)
+        remove_quietly(tmp)
         sys.exit(f"cannot write '{path}': {e.strerror or e}")
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        remove_quietly(tmp)
         raise
+
+
+def remove_quietly(tmp):
+    """The temporary file removed where it can be: on a read-only folder the removal fails as
+    the write did, and the write's cause is the one to report (not a second traceback)."""
+    try:
+        tmp.unlink(missing_ok=True)
+    except OSError:
+        pass
 
 
 def write_text(path, text):

@@ -16,6 +16,7 @@ from femtools.args import command_parser, add_root_option
 # fullmatch, not match with $: $ also matches before a final newline, and a name ending in one
 # made a folder that broke every later build (build.ninja cannot hold a newline).
 NAME = re.compile(r"[a-z][a-z0-9_]*")
+MAX_NAME = 64
 
 
 class VariantError(Exception):
@@ -58,6 +59,9 @@ def readme_heading(text, original, variant):
 
 
 def make_variant(root, number, name):
+    if len(name) > MAX_NAME:  # the folder's name would pass the file system's limit part-way
+        raise VariantError(f"'{name[:20]}...' ({len(name)} characters) is not a variant name: at most "
+                           f"{MAX_NAME} characters (it names a folder, a namespace and build targets)")
     if not NAME.fullmatch(name):
         raise VariantError(f"'{name}' is not a variant name: lower-case letters, digits and _, "
                            "starting with a letter")
