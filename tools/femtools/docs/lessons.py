@@ -11,11 +11,16 @@ import json
 import sys
 
 from femtools.args import command_parser, add_root_option
-from femtools.docs import kernels_alone, provenance
+from femtools.docs import kernels_alone, layouts, provenance
 from femtools.docs.markers import names_in, replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
-# Sections of a lesson's page written from its data besides its table (where the page has them).
-DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: kernels_alone.section}}
+# Sections of a lesson's page written from its record besides its table (where the page has them).
+def roofline_kernels_alone(record, where):
+    return kernels_alone.section(record.get("data"), where)
+
+
+DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: roofline_kernels_alone},
+                 "every-lane": {layouts.MARKER: layouts.section}}
 
 
 def load(path):
@@ -31,7 +36,7 @@ def with_data_sections(text, data, where=None):
     where it has their markers (where: the machine, compiler and commit they were recorded on)."""
     for marker, render in DATA_SECTIONS.get(data["lesson"], {}).items():
         if text is not None:
-            text = replace_between(text, marker, render(data.get("data"), where)) or text
+            text = replace_between(text, marker, render(data, where)) or text
     return text
 
 
