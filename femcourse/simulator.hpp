@@ -85,8 +85,9 @@ struct BodyDescription {
   int solver_max_iterations = 2000;
   std::string chapter;  // "12_half_the_bytes", "12", "half_the_bytes"; empty: the last chapter
   // Threads that step this body (chapters 09 on; the earlier ones use one). 0: one thread
-  // below kSmallBodyNodes nodes, where a second thread gains little and another process on
-  // the machine turns each of its waits into a hitch; OpenMP's count above.
+  // below kSmallBodyNodes nodes, where a second thread shortens the median step but another
+  // process on the machine turns each of its waits into a hitch (docs/library.md, frame
+  // times); OpenMP's count above.
   int threads = 0;
 };
 constexpr int kSmallBodyNodes = 20000;
