@@ -176,14 +176,16 @@ def pair_scaling(scaling, before, after, note=""):
 
 
 def viewer_table(viewer):
-    """The viewer's frame rate per chapter (results/viewer.json, from fem-tools runs viewer-fps)."""
+    """The viewer's frame rate per chapter (results/viewer.json, from fem-tools runs viewer-fps),
+    with the thread count each run's report records, so that the text need not assume one."""
     runs = viewer["runs"]
     rows = [["drawing only (`--paused`)" if r["run"] == "paused" else f"`{r['chapter']}`",
+             f"{r['threads']:g}" if r["run"] != "paused" and "threads" in r else "-",
              f"{r['frames_per_second']:.1f}", ms(r["mean_step_ms"]) if r["run"] != "paused" else "-"]
             for r in runs]
     first = runs[0]
     mesh = pathlib.Path(first["mesh"]).name
-    return (table(["chapter", "frames/s", "mean step (ms)"], rows) +
+    return (table(["chapter", "threads (the report's)", "frames/s", "mean step (ms)"], rows) +
             f"\nMeasured by `./tutorial.sh viewer-bench`: {mesh} ({first['nodes']} nodes), "
             f"{first['width']}x{first['height']}, {viewer['frames']} frames a run, one step per frame, "
             f"renderer {first['renderer']}, {first['cpu']}"
