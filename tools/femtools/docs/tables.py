@@ -389,7 +389,7 @@ def fewer_waits(data, roofline):
         lines.append(f"- the waits removed, priced by the roofline at 2 threads: {saved:.3f} ms a step, "
                      f"{100 * saved / (1e3 * a['step_s']):.1f}% of chapter 12's")
     lines += control_line(recorded, data["mesh"]["file"])
-    where = f"; the roofline's lines {provenance.of_run(roofline)}" if len(lines) > 2 and roofline else ""
+    where = f"; the roofline's lines recorded on {provenance.of_run(roofline)}" if len(lines) > 2 and roofline else ""
     return "\n".join(lines) + f"\n\n{data['mesh']['file']}; {provenance.of_run(data)}{where}.\n"
 
 
