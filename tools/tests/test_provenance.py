@@ -70,18 +70,20 @@ def test_every_table_of_a_block_names_where_it_was_recorded_under_itself(tmp_pat
                      "Medians of 50. Recorded on " + where + ".\n\n| c |\n| --- |\n| 3 |\n\n"
                      "AMD EPYC, GNU 12.2.0, commit 1234567.\n")
     last = dict(block, table="| a |\n| --- |\n| 1 |\n")
-    assert lessons.with_provenance(tmp_path, tmp_path / "x.json", last)[0].endswith("| 1 |\n\nRecorded on " + where + ".\n")
+    table, _ = lessons.with_provenance(tmp_path, tmp_path / "x.json", last)
+    assert table.endswith("| 1 |\n\nRecorded on " + where + ".\n")
 
 
 def test_chapter_13s_measured_section_from_the_committed_data():
-    from femtools.docs import tables
+    from femtools.docs import fewer_waits
     root = pathlib.Path(__file__).resolve().parents[2]
     bench = json.loads((root / "docs" / "data" / "bench.json").read_text())
     roofline = json.loads((root / "docs" / "data" / "lessons" / "roofline.json").read_text())
-    text = tables.fewer_waits(bench, roofline)
+    text = fewer_waits.section(bench, roofline)
     assert text.count("over chapter 12") == 2 and "priced by the roofline at 2 threads" in text
+    assert "the control at 1 thread" in text and "between the kernels" in text
     assert provenance.of_run(bench) in text
-    assert "no chapters 12 and 13" in tables.fewer_waits({"chapters": [], "mesh": {"file": "x"}}, None)
+    assert "no chapters 12 and 13" in fewer_waits.section({"chapters": [], "mesh": {"file": "x"}}, None)
 
 
 def test_dirty_only_where_a_measured_source_differed():

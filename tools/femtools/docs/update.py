@@ -29,7 +29,7 @@ import sys
 
 from femtools.args import command_parser, add_root_option
 from femtools.course import parents
-from femtools.docs import regime_tables, tables
+from femtools.docs import fewer_waits, regime_tables, tables
 from femtools.docs.diffs import chapter_dirs
 from femtools.docs.markers import update_file
 from femtools.results import regimes as regimes_common
@@ -140,7 +140,7 @@ def update_all(root, loaded, stale):
     if loaded["threads"] is not None:
         sections["threads-table"] = tables.threads_table(loaded["threads"], data)
     roofline = root / "docs" / "data" / "lessons" / "roofline.json"
-    sections["fewer-waits"] = tables.fewer_waits(data, load(roofline) if roofline.exists() else None)
+    sections["fewer-waits"] = fewer_waits.section(data, load(roofline) if roofline.exists() else None)
     per_chapter = chapter_sections(root, scaling) if scaling is not None else {}
     for path in doc_files(root):
         update_file(path, own_sections(root, path, {**sections, **per_chapter.get(path, {})}), stale)
