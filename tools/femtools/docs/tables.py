@@ -302,7 +302,7 @@ def chapter_map(root, data):
 
 def chapter_table(root, data, name):
     """A chapter's row beside chapter 01's and the chapter it builds on, with its speedups over
-    both; the caption names the base where it is not the chapter before in order."""
+    both ("(its base)" where that is not the chapter before in order)."""
     by = chapters_by_name(data)
     c = by[name]
     previous = reference_row(root, data, name)
@@ -323,8 +323,7 @@ def chapter_table(root, data, name):
                       f"{ms(fused_ms(c))} ms in `{c['chapter']}` ({ratio(fused_ms(previous), fused_ms(c))}).")
     return (table(header, rows) +
             f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; {provenance.of_run(data)} "
-            f"([flags](../../docs/results.md)).{base_note(root, name, previous and chapter_dir(previous['chapter']))}"
-            f"{fused_note}\n")
+            f"([flags](../../docs/results.md)).{fused_note}\n")
 
 
 def base_note(root, name, base):
@@ -332,8 +331,7 @@ def base_note(root, name, base):
     that is not the chapter before it in order; else ""."""
     if base is None or base != parents.parent_of(root, name) or not parents.over(root, name, base):
         return ""
-    return (f" `{chapter_dir(name)}` builds on `{base}` (its recipe's `BuildsOn`), not on the chapter "
-            f"before it, `{parents.chapter_before(root, name)}`: it is compared with its base.")
+    return f" `{base}` is its base (`BuildsOn`), not `{parents.chapter_before(root, name)}`."
 
 
 def threads_table(threads, bench=None):
