@@ -90,9 +90,9 @@ struct BodyDescription {
   std::string chapter;  // "12_half_the_bytes", "12", "half_the_bytes"; empty: the last chapter
   // Threads that step this body (chapters 09 on; the earlier ones use one): every step runs
   // on exactly this many. 0 (not asked): one thread below kSmallBodyNodes nodes, where a
-  // second thread gains little and another process on the machine turns each of its waits
-  // into a hitch; above, OpenMP's count, or one thread while that is faster (chapter 09's
-  // adaptive team). threads_used() says what ran.
+  // second thread shortens the median step but another process on the machine turns each of
+  // its waits into a hitch (docs/library.md, frame times); above, OpenMP's count, or one
+  // thread while that is faster (chapter 09's adaptive team). threads_used() says what ran.
   int threads = 0;
 };
 constexpr int kSmallBodyNodes = 20000;

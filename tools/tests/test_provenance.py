@@ -60,15 +60,30 @@ def test_the_caption_adds_the_commit_or_all_three(tmp_path):
     assert lessons.with_provenance(tmp_path, tmp_path / "x.json", counts) == (counts["table"], None)
 
 
+def test_every_table_of_a_block_names_where_it_was_recorded_under_itself(tmp_path):
+    where = "AMD EPYC (2 cores), GNU 12.2.0, commit 1234567"
+    block = {"machine": MACHINE, "build": BUILD, "commit": "1234567",
+             "table": "| a |\n| --- |\n| 1 |\n\n| b |\n| --- |\n| 2 |\n\nMedians of 50.\n\n"
+                      "| c |\n| --- |\n| 3 |\n\nAMD EPYC, GNU 12.2.0, commit 1234567.\n"}
+    table, _ = lessons.with_provenance(tmp_path, tmp_path / "x.json", block)
+    assert table == ("| a |\n| --- |\n| 1 |\n\nRecorded on " + where + ".\n\n| b |\n| --- |\n| 2 |\n\n"
+                     "Medians of 50. Recorded on " + where + ".\n\n| c |\n| --- |\n| 3 |\n\n"
+                     "AMD EPYC, GNU 12.2.0, commit 1234567.\n")
+    last = dict(block, table="| a |\n| --- |\n| 1 |\n")
+    table, _ = lessons.with_provenance(tmp_path, tmp_path / "x.json", last)
+    assert table.endswith("| 1 |\n\nRecorded on " + where + ".\n")
+
+
 def test_chapter_13s_measured_section_from_the_committed_data():
-    from femtools.docs import tables
+    from femtools.docs import fewer_waits
     root = pathlib.Path(__file__).resolve().parents[2]
     bench = json.loads((root / "docs" / "data" / "bench.json").read_text())
     roofline = json.loads((root / "docs" / "data" / "lessons" / "roofline.json").read_text())
-    text = tables.fewer_waits(bench, roofline)
+    text = fewer_waits.section(bench, roofline)
     assert text.count("over chapter 12") == 2 and "priced by the roofline at 2 threads" in text
+    assert "the control at 1 thread" in text and "between the kernels" in text
     assert provenance.of_run(bench) in text
-    assert "no chapters 12 and 13" in tables.fewer_waits({"chapters": [], "mesh": {"file": "x"}}, None)
+    assert "no chapters 12 and 13" in fewer_waits.section({"chapters": [], "mesh": {"file": "x"}}, None)
 
 
 def test_dirty_only_where_a_measured_source_differed():

@@ -11,11 +11,16 @@ import json
 import sys
 
 from femtools.args import command_parser, add_root_option
-from femtools.docs import kernels_alone, provenance
+from femtools.docs import kernels_alone, layouts, provenance
 from femtools.docs.markers import names_in, replace_between
 FIELDS = ("lesson", "readme", "marker", "command", "table")
-# Sections of a lesson's page written from its data besides its table (where the page has them).
-DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: kernels_alone.section}}
+# Sections of a lesson's page written from its record besides its table (where the page has them).
+def roofline_kernels_alone(record, where):
+    return kernels_alone.section(record.get("data"), where)
+
+
+DATA_SECTIONS = {"roofline": {kernels_alone.MARKER: roofline_kernels_alone},
+                 "every-lane": {layouts.MARKER: layouts.section}}
 
 
 def load(path):
@@ -31,25 +36,66 @@ def with_data_sections(text, data, where=None):
     where it has their markers (where: the machine, compiler and commit they were recorded on)."""
     for marker, render in DATA_SECTIONS.get(data["lesson"], {}).items():
         if text is not None:
-            text = replace_between(text, marker, render(data.get("data"), where)) or text
+            text = replace_between(text, marker, render(data, where)) or text
     return text
 
 
 def with_provenance(root, path, data):
-    """The lesson's table, its caption naming the machine, the compiler and the commit it was
-    recorded on (a table without a machine record, counts from Python, as it is): the commit
-    alone where the caption already names the machine and the compiler."""
+    """The lesson's tables, each one's own caption naming the machine, the compiler and the
+    commit it was recorded on (a table without a machine record, counts from Python, as it is):
+    the commit alone where a caption already names the machine and the compiler."""
     machine = data.get("machine")
     if not isinstance(machine, dict):
         return data["table"], None
     compiler, commit = provenance.lesson_build(root, path, data)
     where = provenance.describe(machine, compiler, commit, data.get("uncommitted"))
-    cpu = machine.get("cpu") or machine.get("model_name") or ""
-    table = data["table"].rstrip("\n")
-    named = bool(cpu) and cpu in table and bool(compiler) and compiler in table
-    table += " " if table.endswith(".") else ". "
-    return (table + (f"Recorded at commit {provenance.short_commit(commit, data.get('uncommitted'))}.\n" if named
-                     else f"Recorded on {where}.\n"), where)
+    names = (machine.get("cpu") or machine.get("model_name") or "", compiler or "",
+             provenance.short_commit(commit, data.get("uncommitted")))
+    return captioned(data["table"], names, where), where
+
+
+def blocks(text):
+    """text as its runs of lines: [is a table, lines]."""
+    runs = []
+    for line in text.split("\n"):
+        row = line.startswith("|")
+        if runs and runs[-1][0] == row:
+            runs[-1][1].append(line)
+        else:
+            runs.append([row, [line]])
+    return runs
+
+
+def with_names(caption, names, where):
+    """A table's caption (its lines up to the next table) that names its machine, compiler and
+    commit (names): as it is where it does, else with the missing ones added to its last line."""
+    cpu, compiler, commit = names
+    text = "\n".join(caption)
+    if all(n and n in text for n in names):
+        return caption
+    added = f"Recorded at commit {commit}." if cpu and cpu in text and compiler and compiler in text \
+        else f"Recorded on {where}."
+    last = max((i for i, line in enumerate(caption) if line.strip()), default=None)
+    if last is None:  # a table directly followed by the next: a caption of its own
+        return ["", added, ""]
+    line = caption[last].rstrip()
+    caption = list(caption)
+    caption[last] = line + (" " if line.endswith(".") else ". ") + added
+    return caption
+
+
+def captioned(table, names, where):
+    """Every table of a lesson's text with a caption of its own naming where it was recorded:
+    a block of several tables names it under each, not only under the last."""
+    runs = blocks(table.rstrip("\n"))
+    if runs and runs[-1][0]:
+        runs.append([False, [""]])
+    out = []
+    for k, (row, lines) in enumerate(runs):
+        if not row and k > 0:
+            lines = with_names(lines, names, where)
+        out.extend(lines)
+    return "\n".join(out).rstrip("\n") + "\n"
 
 
 def chapter_kernels_alone(root, data, where=None):

@@ -4,6 +4,7 @@ between its markers by `fem-tools docs update`."""
 import pathlib
 import re
 
+from femtools.course import parents
 from femtools.docs import provenance
 from femtools.docs.markdown import ms, ratio, table
 from femtools.results import poster
@@ -112,8 +113,9 @@ def scaling_table(scaling):
             table(["median CG iterations / nodes"] + [str(n) for n in sizes], it_rows))
 
 
-def per_node_scaling(scaling, before, this):
-    """A chapter over the beam series (docs/data/scaling.json) beside the chapter before it:
+def per_node_scaling(scaling, before, this, note=""):
+    """A chapter over the beam series (docs/data/scaling.json) beside the chapter it builds on
+    (before; note: the caption's sentence saying so where that is not the chapter before it):
     iterations, solve and step time per node from the smallest mesh to the largest. How much
     more slowly the one's solve grows with the mesh than the other's, on this machine."""
     rows = []
@@ -137,14 +139,15 @@ def per_node_scaling(scaling, before, this):
     return (table(["chapter", "nodes, smallest to largest beam", "median CG iterations",
                    "median step (ms)", "solve per node (us)", "step per node (us)"], rows) +
             f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, "
-            f"{provenance.of_run(scaling)}. {NOTE} from docs/data/scaling.json.\n")
+            f"{provenance.of_run(scaling)}.{note} {NOTE} from docs/data/scaling.json.\n")
 
 
-def pair_scaling(scaling, before, after):
+def pair_scaling(scaling, before, after, note=""):
     """Two chapters over the beam series (docs/data/scaling.json): the rest of the step (step
     minus solve: the element pass and the system's start) and the solve, at each thread count,
-    with the later chapter's ratio to the earlier one. Chapter 11 against 10 (the order of
-    memory), chapter 12 against 11 (half the bytes): what each measures to on this machine."""
+    with the later chapter's ratio to the earlier one (its base; note: the caption's sentence
+    saying so where that is not the chapter before it). Chapter 11 against 10 (the order of
+    memory), chapter 14 against 12 (every lane): what each measures to on this machine."""
     by = {(r["chapter"], r["mesh"]): r for r in scaling["runs"]}
     short = [c.split("_")[0] for c in (before, after)]
     rows = []
@@ -169,18 +172,20 @@ def pair_scaling(scaling, before, after):
     return (table(["mesh", "nodes", "threads", f"step minus solve, ms: {pair} (speedup)",
                    f"solve, ms: {pair}", f"step, ms: {pair}", f"CG it.: {pair}"], rows) +
             f"\nThe beam series of `./tutorial.sh scaling`, {scaling['scene']} scene, "
-            f"{provenance.of_run(scaling)}. {NOTE} from docs/data/scaling.json.\n")
+            f"{provenance.of_run(scaling)}.{note} {NOTE} from docs/data/scaling.json.\n")
 
 
 def viewer_table(viewer):
-    """The viewer's frame rate per chapter (results/viewer.json, from fem-tools runs viewer-fps)."""
+    """The viewer's frame rate per chapter (results/viewer.json, from fem-tools runs viewer-fps),
+    with the thread count each run's report records, so that the text need not assume one."""
     runs = viewer["runs"]
     rows = [["drawing only (`--paused`)" if r["run"] == "paused" else f"`{r['chapter']}`",
+             f"{r['threads']:g}" if r["run"] != "paused" and "threads" in r else "-",
              f"{r['frames_per_second']:.1f}", ms(r["mean_step_ms"]) if r["run"] != "paused" else "-"]
             for r in runs]
     first = runs[0]
     mesh = pathlib.Path(first["mesh"]).name
-    return (table(["chapter", "frames/s", "mean step (ms)"], rows) +
+    return (table(["chapter", "threads (the report's)", "frames/s", "mean step (ms)"], rows) +
             f"\nMeasured by `./tutorial.sh viewer-bench`: {mesh} ({first['nodes']} nodes), "
             f"{first['width']}x{first['height']}, {viewer['frames']} frames a run, one step per frame, "
             f"renderer {first['renderer']}, {first['cpu']}"
@@ -208,17 +213,30 @@ def headline(data):
             f"{b['compiler']} `{b['flags']}`, commit {data['commit']}.\n")
 
 
-def reference_row(data, name):
-    """The row a chapter's row is compared with: the row before it, except that a threaded row
-    compares with the chapter before at the same thread count (10@2 with 09@2); without one
-    (09@2: chapter 08 runs on one thread) with the row before (09@1)."""
+def reference_row(root, data, name):
+    """The row a chapter's row is compared with: the chapter it builds on (its recipe's parent,
+    parents.parent_of: 14 builds on 12, not 13) at the same thread count (10@2 with 09@2); where
+    the parent has no row at that count (09@2: chapter 08 runs on one thread), the row before
+    (09@1); where the data hold no row of the parent (a run of a few chapters), the row before."""
     rows = data["chapters"]
     i = next(k for k, x in enumerate(rows) if x["chapter"] == name)
-    same_threads = [x for x in rows[:i] if chapter_dir(x["chapter"]) != chapter_dir(name)
-                    and x.get("threads", 1) == rows[i].get("threads", 1)]
-    if "@" in name and same_threads:
+    parent = parents.parent_of(root, name)
+    if parent is None and i == 0:
+        return None
+    threads = rows[i].get("threads", 1)
+    of_parent = [x for x in rows if chapter_dir(x["chapter"]) == parent]
+    same_threads = [x for x in of_parent if x.get("threads", 1) == threads]
+    if same_threads:
         return same_threads[-1]
     return rows[i - 1] if i > 0 else None
+
+
+def over(root, name, ref):
+    """ "over `12_half_the_bytes@1` (its base)": the reference row, and why it is not the
+    chapter before where it is not."""
+    base = parents.over(root, name, ref["chapter"]) if chapter_dir(ref["chapter"]) == \
+        parents.parent_of(root, name) else ""
+    return f"over `{ref['chapter']}`{base}"
 
 
 # A phase whose time moves by less than this share of the reference row's step is noise for
@@ -226,16 +244,16 @@ def reference_row(data, name):
 MOVED_SHARE = 0.02
 
 
-def moved_most(c, ref, phases):
-    """The phase a chapter moves most against its reference row, by the milliseconds it saves
-    or costs, not by the ratio (a ratio of two tiny times is noise); in either direction,
-    with its ratio; "no phase by more than 2% of the step" when none moves that much."""
+def moved_most(c, ref, phases, against):
+    """The phase a chapter moves most against its reference row (against: "over `ref`"), by the
+    milliseconds it saves or costs, not by the ratio (a ratio of two tiny times is noise); in
+    either direction, with its ratio; "no phase by more than 2% of the step" when none moves
+    that much."""
     phase = max(phases, key=lambda p: abs(ref["median_ms"][p] - c["median_ms"][p]))
     change = abs(ref["median_ms"][phase] - c["median_ms"][phase])
     if change < MOVED_SHARE * ref["median_ms"]["step"]:
-        return f"no phase by more than {100 * MOVED_SHARE:g}% of the step over `{ref['chapter']}`"
-    return (f"{PHASE_LABELS[phase]} {ratio(ref['median_ms'][phase], c['median_ms'][phase])} "
-            f"over `{ref['chapter']}`")
+        return f"no phase by more than {100 * MOVED_SHARE:g}% of the step {against}"
+    return f"{PHASE_LABELS[phase]} {ratio(ref['median_ms'][phase], c['median_ms'][phase])} {against}"
 
 
 def readme_title(root, name, fallback):
@@ -256,22 +274,23 @@ def fused_ms(row):
     return sum(row["median_ms"][p] for p in FUSED)
 
 
-def chapter_map(data):
-    """One line per chapter: the idea, the phase it moves most, the overall step speedup."""
+def chapter_map(root, data):
+    """One line per chapter: the idea, the phase it moves most against the chapter it builds on,
+    the overall step speedup."""
     by = chapters_by_name(data)
     base = by.get(BASELINE)
     rows, previous = [], None
     for c in data["chapters"]:
         name = c["chapter"]
         moved = "the baseline"
-        ref = reference_row(data, name)
+        ref = reference_row(root, data, name)
         if ref is not None and c["median_ms"]["dfdx"] == 0 < ref["median_ms"]["dfdx"]:
             # A fused element pass (chapter 08) has no df/dx phase of its own: compare the three
             # phases it replaces together, not a zero.
             moved = (f"forces + df/dx + composition (fused) {ratio(fused_ms(ref), fused_ms(c))} "
-                     f"over `{ref['chapter']}`")
+                     f"{over(root, name, ref)}")
         elif ref is not None:
-            moved = moved_most(c, ref, parts(data))
+            moved = moved_most(c, ref, parts(data), over(root, name, ref))
         diff = f"[diff](docs/diffs/{chapter_dir(name)}.diff)" if previous is not None and \
             chapter_dir(previous["chapter"]) != chapter_dir(name) else ""
         rows.append([f"[`{name}`](chapters/{chapter_dir(name)}/README.md)", c.get("title", ""), moved,
@@ -281,17 +300,19 @@ def chapter_map(data):
                  rows, ["---", "---", "---", "---:", "---"]) + recorded_on(data, "Medians' ratios")
 
 
-def chapter_table(data, name):
+def chapter_table(root, data, name):
+    """A chapter's row beside chapter 01's and the chapter it builds on, with its speedups over
+    both ("(its base)" where that is not the chapter before in order)."""
     by = chapters_by_name(data)
     c = by[name]
-    previous = reference_row(data, name)
+    previous = reference_row(root, data, name)
     shown = [x for x in (by.get(BASELINE), previous, c) if x is not None]
     shown = [x for i, x in enumerate(shown) if x not in shown[:i]]
     rows = [[f"`{x['chapter']}`"] + [ms(x["median_ms"][p]) for p in all_phases(data)] +
             [f"{x['allocations_per_step']:g}", f"{x['cg_iterations']:g}"] for x in shown]
     refs = [r for r in (by.get(BASELINE), previous) if r is not None and r is not c]
     for ref in [r for i, r in enumerate(refs) if r not in refs[:i]]:  # 02: previous is 01
-        rows.append([f"speedup over `{ref['chapter']}`"] +
+        rows.append([f"speedup {over(root, name, ref)}"] +
                     [ratio(ref["median_ms"][p], c["median_ms"][p]) for p in all_phases(data)] + ["", ""])
     header = ["median ms"] + [PHASE_LABELS[p] for p in all_phases(data)] + ["allocations/step", "CG it."]
     fused_note = ""
@@ -303,6 +324,14 @@ def chapter_table(data, name):
     return (table(header, rows) +
             f"\n{data['mesh']['file']}, {data['scene']}, {data['steps']} steps; {provenance.of_run(data)} "
             f"([flags](../../docs/results.md)).{fused_note}\n")
+
+
+def base_note(root, name, base):
+    """A caption's sentence on the chapter `name` is compared with, its base (a folder), where
+    that is not the chapter before it in order; else ""."""
+    if base is None or base != parents.parent_of(root, name) or not parents.over(root, name, base):
+        return ""
+    return f" `{base}` is its base (`BuildsOn`), not `{parents.chapter_before(root, name)}`."
 
 
 def threads_table(threads, bench=None):
@@ -330,29 +359,3 @@ def threads_table(threads, bench=None):
                "compare the rows of one table, not milliseconds across tables."
                if bench is not None and bench.get("commit") != threads.get("commit") else "")
             + f" {NOTE}.\n")
-
-
-def fewer_waits(data, roofline):
-    """Chapter 13 against chapter 12, as measured: the step's speedup at one thread (the control:
-    no waits to save) and at two, with each row's quartiles, and the price the roofline puts on
-    the waits chapter 13 removes (docs/data/lessons/roofline.json: each run's "waiting_s", the
-    step's barriers and regions times their measured price on a spinning team)."""
-    by = chapters_by_name(data)
-    rows = {t: (by.get(f"12_half_the_bytes@{t}"), by.get(f"13_fewer_waits@{t}")) for t in (1, 2)}
-    if not all(a and b for a, b in rows.values()):
-        return "(no chapters 12 and 13 at 1 and 2 threads in docs/data/bench.json)\n"
-
-    def step(c):
-        return f"{ms(c['median_ms']['step'])} [{ms(c['q1_ms']['step'])}, {ms(c['q3_ms']['step'])}]"
-
-    lines = [f"- {t} thread{'s' if t > 1 else ''}: {ratio(a['median_ms']['step'], b['median_ms']['step'])} over "
-             f"chapter 12; steps {step(a)} and {step(b)} ms (median [quartiles], 12 and 13)"
-             for t, (a, b) in rows.items()]
-    runs = {r["chapter"]: r for r in ((roofline or {}).get("data") or {}).get("runs", [])
-            if r.get("threads") == 2 and r.get("mesh") == data["mesh"]["file"]}
-    a, b = runs.get("12_half_the_bytes"), runs.get("13_fewer_waits")
-    if a and b:
-        saved = 1e3 * (a["waiting_s"] - b["waiting_s"])
-        lines.append(f"- the waits removed, priced by the roofline at 2 threads: {saved:.3f} ms a step, "
-                     f"{100 * saved / (1e3 * a['step_s']):.1f}% of chapter 12's")
-    return "\n".join(lines) + f"\n\n{data['mesh']['file']}; {provenance.of_run(data)}.\n"

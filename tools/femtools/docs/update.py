@@ -5,7 +5,7 @@ and the chapters' READMEs, wherever it stands:
   from bench.json          results:machine, results:phases, results:speedups, results:allocations,
                            results:solvers, headline, chapter-map, bench-table:<chapter row>
   from scaling.json        results:scaling, and in a chapter's README scaling-per-node and
-                           scaling-pair (that chapter beside the course's chapter before it)
+                           scaling-pair (that chapter beside the chapter it builds on)
   from bench.json and      fewer-waits (chapter 13 against 12, and the roofline's price of the
   lessons/roofline.json    waits it removes)
   from viewer.json         viewer-fps
@@ -28,15 +28,16 @@ import shutil
 import sys
 
 from femtools.args import command_parser, add_root_option
-from femtools.docs import regime_tables, tables
+from femtools.course import parents
+from femtools.docs import fewer_waits, regime_tables, tables
 from femtools.docs.diffs import chapter_dirs
 from femtools.docs.markers import update_file
 from femtools.results import regimes as regimes_common
 from femtools.results.common import ResultsError, chapter_dir, die, load
 from femtools.results.schema import load_checked
 
-# The sections of a chapter's README that set the chapter beside the course's chapter before it,
-# over the beam series: the marker names the table, the README's folder the chapters.
+# The sections of a chapter's README that set the chapter beside the chapter it builds on (its
+# recipe's parent), over the beam series: the marker names the table, the README's folder the chapters.
 CHAPTER_SCALING = {"scaling-per-node": tables.per_node_scaling, "scaling-pair": tables.pair_scaling}
 
 
@@ -106,8 +107,8 @@ def bench_sections(root, data, scaling, check):
         "results:machine": tables.machine_table(data), "results:phases": tables.phases_table(data),
         "results:speedups": tables.speedups_table(data), "results:allocations": tables.allocations_table(data),
         "results:solvers": tables.solvers_table(data),
-        "headline": tables.headline(data), "chapter-map": tables.chapter_map(data)}
-    sections.update({f"bench-table:{c['chapter']}": tables.chapter_table(data, c["chapter"])
+        "headline": tables.headline(data), "chapter-map": tables.chapter_map(root, data)}
+    sections.update({f"bench-table:{c['chapter']}": tables.chapter_table(root, data, c["chapter"])
                      for c in data["chapters"]})
     # The scaling run takes tens of minutes and is optional: without results/scaling.json the
     # committed table stays as it is (a placeholder goes in only where there is no table yet).
@@ -119,11 +120,14 @@ def bench_sections(root, data, scaling, check):
 
 
 def chapter_sections(root, scaling):
-    """Per course chapter's README, its sections that set it beside the chapter before it."""
-    course = chapter_dirs(root)
-    return {this / "README.md": {name: make(scaling, before.name, this.name)
-                                 for name, make in CHAPTER_SCALING.items()}
-            for before, this in zip(course, course[1:])}
+    """Per course chapter's README, its sections that set it beside the chapter it builds on."""
+    sections = {}
+    for this in chapter_dirs(root)[1:]:
+        base = parents.parent_of(root, this.name)
+        note = tables.base_note(root, this.name, base)
+        sections[this / "README.md"] = {name: make(scaling, base, this.name, note)
+                                        for name, make in CHAPTER_SCALING.items()}
+    return sections
 
 
 def update_all(root, loaded, stale):
@@ -136,7 +140,7 @@ def update_all(root, loaded, stale):
     if loaded["threads"] is not None:
         sections["threads-table"] = tables.threads_table(loaded["threads"], data)
     roofline = root / "docs" / "data" / "lessons" / "roofline.json"
-    sections["fewer-waits"] = tables.fewer_waits(data, load(roofline) if roofline.exists() else None)
+    sections["fewer-waits"] = fewer_waits.section(data, load(roofline) if roofline.exists() else None)
     per_chapter = chapter_sections(root, scaling) if scaling is not None else {}
     for path in doc_files(root):
         update_file(path, own_sections(root, path, {**sections, **per_chapter.get(path, {})}), stale)
