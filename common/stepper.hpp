@@ -101,6 +101,8 @@ class Stepper {
   // each count. A variant that threads a chapter of its own (chapter 07's exercise 3)
   // overrides it to return true.
   virtual bool uses_threads() const { return false; }
+  // The threads the last step ran on, by the stepper's own record (0: it does not say).
+  virtual int threads_used() const { return 0; }
 
   // Replaces the sparse interaction forces from the next step on: the scene's own, or
   // the viewer's mouse spring. The storage is reused, so once it has held as many

@@ -194,8 +194,6 @@ struct Body::Impl {
   fem::Scene scene;  // first: the stepper is built from it and may keep a reference
   StepperFactory make;
   std::unique_ptr<fem::Stepper> stepper;
-  // The chapter's record of what its stepper ran (chapters/work.hpp): the team of a step.
-  fem::ExecutedWork (*executed)(const fem::Stepper&) = nullptr;
   int threads_used = 0;  // the last step's team
   fem::State state;
   Eigen::VectorXd previous_v;  // before the last step: the reactions' dv
@@ -265,8 +263,8 @@ struct Body::Impl {
   // Inside the step's thread scope: the team its stepper recorded, else the count in force
   // for a stepper that threads without saying, else one.
   int team_of_last_step() const {
-    const double team = executed ? executed(*stepper).team : 0.0;
-    if (team > 0.0) return static_cast<int>(team);
+    const int team = stepper->threads_used();
+    if (team > 0) return team;
     return stepper->uses_threads() ? fem::max_threads() : 1;
   }
   void set_floor(bool on, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
@@ -409,7 +407,6 @@ Body::Body(const BodyDescription& d, const StepperFactory& make_stepper) {
   } else {
     const fem::ChapterInfo& info = chapter_of(d.chapter);
     impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
-    impl_->executed = info.work.executed;
   }
   impl_->threads = d.threads;
   impl_->substeps = d.substeps;
@@ -419,7 +416,6 @@ Body::Body(fem::Scene scene, const fem::SolverSettings& solver, const std::strin
   fem::validate(scene);
   const fem::ChapterInfo& info = chapter_of(chapter);
   impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
-  impl_->executed = info.work.executed;
 }
 
 Body::~Body() = default;
@@ -504,7 +500,6 @@ void Body::set_chapter(const std::string& chapter) {
   // Nothing above changed the body: from here on nothing throws.
   b.stepper = std::move(next);
   b.make = info.make;
-  b.executed = info.work.executed;
   b.chapter = info.id;
 }
 

@@ -6,7 +6,7 @@
 // | Order          | (const Scene&, const Params&)  | scene(), element_group(), step(state, f), |
 // |                |                                | set_constraints(c), inward(forces),       |
 // |                |                                | outward(f_ext), outward_forces(f_ext)     |
-// | Team           | default                        | run(f, step_seconds), kThreads            |
+// | Team           | default                        | run(f, step_seconds), kThreads, threads() |
 // | Elements       | (const PartSetup&, const Params&) | start_system(in, state, system) const, |
 // |                |                                | pass(in, state, system)                   |
 // | Guess          | (const PartSetup&, const Params&) | guess(y)                               |
@@ -192,6 +192,7 @@ struct Body {
 };
 FEM_DETECT(has_run, ref<T>().run(Body{}, ref<const double>()));
 FEM_DETECT(has_threads_flag, bool(T::kThreads));
+FEM_DETECT(has_threads_used, int(ref<const T>().threads()));
 
 // Elements.
 FEM_DETECT(has_start_system,
@@ -261,7 +262,7 @@ struct Members {
       has_inward<Order>::value && has_outward<Order>::value && has_outward_forces<Order>::value;
   static constexpr bool team_built = std::is_default_constructible_v<Team>;
   static constexpr bool team_run = has_run<Team>::value;
-  static constexpr bool team_threads = has_threads_flag<Team>::value;
+  static constexpr bool team_threads = has_threads_flag<Team>::value && has_threads_used<Team>::value;
   static constexpr bool elements_built = built<Elements>();
   static constexpr bool elements_start = has_start_system<Elements>::value;
   static constexpr bool elements_pass = has_pass<Elements>::value;
@@ -330,7 +331,7 @@ constexpr bool check_recipe() {
                   "Order part: no inward(forces), outward(f_ext) or outward_forces(f_ext)");
     static_assert(M::team_built, "Team part: not default-constructible");
     static_assert(M::team_run, "Team part: no run(step, const double& step_seconds)");
-    static_assert(M::team_threads, "Team part: no kThreads");
+    static_assert(M::team_threads, "Team part: no kThreads, or no threads() of the last step");
     static_assert(M::elements_built,
                   "Elements part: no Params, or no constructor (const PartSetup&, const Params&)");
     static_assert(M::elements_start,

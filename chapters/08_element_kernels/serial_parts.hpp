@@ -48,6 +48,7 @@ struct OneThread {
   static constexpr const char* kName = "one thread";
   static constexpr std::string_view kChapter = FEM_PART_CHAPTER;
   static constexpr bool kThreads = false;
+  int threads() const { return 1; }  // of the last step
   template <class Step>
   void run(Step&& step, const double& /*step_seconds*/) {
     step();

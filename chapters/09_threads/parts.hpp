@@ -28,6 +28,7 @@ class TeamOfThreads {
   }
   // Tests that compare thread counts keep the count they set (off); the environment variable
   // FEM_ADAPTIVE_TEAM=0 turns it off for a whole program (to see what it prevents).
+  int threads() const { return adaptive_team_.team(); }  // of the last step, as it ran
   AdaptiveTeam& adaptive_team() { return adaptive_team_; }
   const AdaptiveTeam& adaptive_team() const { return adaptive_team_; }
 

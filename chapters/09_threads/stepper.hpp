@@ -6,8 +6,7 @@
 // is the same to the last bit for any thread count.
 #pragma once
 
-#include "chapters/08_element_kernels/serial_parts.hpp"
-#include "chapters/08_element_kernels/step.hpp"
+// The recipe it builds on, and the files of the parts it adds.
 #include "chapters/08_element_kernels/stepper.hpp"
 #include "chapters/09_threads/parts.hpp"
 #include "chapters/09_threads/threaded_elements.hpp"

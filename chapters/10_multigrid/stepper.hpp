@@ -7,11 +7,8 @@
 // guess is extrapolated from the last solutions.
 #pragma once
 
-#include "chapters/08_element_kernels/serial_parts.hpp"
-#include "chapters/08_element_kernels/step.hpp"
-#include "chapters/09_threads/parts.hpp"
+// The recipe it builds on, and the files of the parts it adds.
 #include "chapters/09_threads/stepper.hpp"
-#include "chapters/09_threads/threaded_elements.hpp"
 #include "chapters/10_multigrid/parts.hpp"
 
 namespace fem::ch10 {

@@ -5,10 +5,7 @@
 // boundary.
 #pragma once
 
-#include "chapters/08_element_kernels/step.hpp"
-#include "chapters/09_threads/parts.hpp"
-#include "chapters/09_threads/threaded_elements.hpp"
-#include "chapters/10_multigrid/parts.hpp"
+// The recipe it builds on, and the files of the parts it adds.
 #include "chapters/10_multigrid/stepper.hpp"
 #include "chapters/11_node_order/renumbered_nodes.hpp"
 

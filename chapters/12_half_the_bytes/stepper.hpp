@@ -5,10 +5,7 @@
 // register, where Eigen's fixed-size 3x3 types leave most lanes empty.
 #pragma once
 
-#include "chapters/08_element_kernels/step.hpp"
-#include "chapters/09_threads/parts.hpp"
-#include "chapters/10_multigrid/parts.hpp"
-#include "chapters/11_node_order/renumbered_nodes.hpp"
+// The recipe it builds on, and the files of the parts it adds.
 #include "chapters/11_node_order/stepper.hpp"
 #include "chapters/12_half_the_bytes/parts.hpp"
 

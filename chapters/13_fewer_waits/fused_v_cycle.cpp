@@ -42,7 +42,7 @@ void FusedVCycle::complete(Eigen::VectorXd& s, const RowsCall& finish) {
 }
 
 void FusedVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-  if (!fused()) {  // one level, or one thread: nothing to fuse
+  if (!fused()) {  // one level, or a finest level below rows.serial_rows: nothing to fuse
     reduced_.apply(r, s);
     return;
   }

@@ -4,11 +4,7 @@
 // reads only its own rows can run inside the loop before it.
 #pragma once
 
-#include "chapters/08_element_kernels/step.hpp"
-#include "chapters/09_threads/parts.hpp"
-#include "chapters/10_multigrid/parts.hpp"
-#include "chapters/11_node_order/renumbered_nodes.hpp"
-#include "chapters/12_half_the_bytes/parts.hpp"
+// The recipe it builds on, and the files of the parts it adds.
 #include "chapters/12_half_the_bytes/stepper.hpp"
 #include "chapters/13_fewer_waits/parts.hpp"
 

@@ -6,7 +6,7 @@
 // longer than the terms (chapter 12's `fem_lessons batched-elements` table). On AVX-512 a
 // block's first eight entries fit one register: each pair's lanes are transposed once a batch,
 // and a block is added by one load, one addition and one store (lane_scatter.cpp). And where A
-// is larger than the last cache (the ~82k-node beam's), each block's lines come from memory
+// is larger than the last cache the machine reports, each block's lines come from memory
 // and the scatter waits on them, the longer the larger the mesh (the same table): the slots
 // are known at set-up (the index's element blocks, chapter 07), so the next batch's sixteen
 // blocks and its corners' x, v and b are prefetched (__builtin_prefetch, GCC and Clang) before

@@ -6,9 +6,11 @@
 //
 // Which layout depends on where the level will live. In cache, the kernel is held in the core
 // and the padded pairs are the faster (a pair's column is one load, 48 bytes a block); from
-// memory it is held by its bytes, and the packed pairs read chapter 12's 36. The choice is made
-// once, from the level's size against the last cache the machine reports, never from the
-// thread count: the same bits on any number of threads.
+// memory a kernel held by its bytes would favour the packed pairs, chapter 12's 36 bytes. The
+// choice is made once, from the level's size against the last cache the machine reports,
+// never from the thread count: the same bits on any number of threads. That rule is a
+// measurement, not a law: the lesson's table (`fem_lessons every-lane`) times both layouts at
+// one and two threads and says where the stepper runs the slower one.
 #pragma once
 
 #include <Eigen/Core>
@@ -23,8 +25,9 @@
 namespace fem::ch14 {
 
 // The finest level's layouts: a row's blocks in pairs, one pair per 256 bits of float, padded
-// where the level fits in the last cache, packed where it does not (the faster of each on the
-// AMD EPYC measured); RowPairFineLevel puts two rows' pairs in 512 bits.
+// where the level fits in the last cache, packed where it does not (the README's layout lines
+// say, per mesh and thread count, which one measured faster); RowPairFineLevel puts two rows'
+// pairs in 512 bits.
 using InCacheLanes = LaneFineLevel;
 using FromMemoryLanes = PackedFineLevel;
 

@@ -53,15 +53,19 @@ def names(chapter):
             "recipe": recipe.group(1) if recipe else ""}
 
 
-def renamed(text, old, new, files=()):
+def renamed(text, old, new, files=(), recipe=False):
     """text of chapter `old` with the code names of chapter `new` (namespace, stepper, recipe), which copied `files` from
-    it; the words stay the old text's ("Chapter NN" is not renamed)."""
+    it; the words stay the old text's ("Chapter NN" is not renamed). In a recipe (`recipe`) a
+    qualified name such as ch10::Extrapolation names chapter 10's part in either chapter: only
+    the chapter's own namespace (fem::ch10) is renamed."""
     # Its stepper.hpp (the registry's file) and the files the new chapter copied, under the new
     # chapter's path.
     own = "|".join(re.escape(f) for f in sorted({"stepper.hpp", *files}))
     text = re.sub(rf"chapters/{old['id']}/({own})\b", rf"chapters/{new['id']}/\1", text)
     text = re.sub(rf"(?<!chapters/)\b{old['id']}\b", new["id"], text)
-    if old["namespace"]:
+    if old["namespace"] and recipe:
+        text = re.sub(rf"\bfem::{old['namespace']}\b", f"fem::{new['namespace']}", text)
+    elif old["namespace"]:
         text = re.sub(rf"\b{old['namespace']}\b", new["namespace"], text)
     for name in ("class", "recipe"):
         if old[name] and new[name]:
@@ -114,7 +118,8 @@ def file_diff(parent, current, name, root, copied):
         return list(difflib.unified_diff([], new_lines, fromfile="/dev/null",
                                          tofile=str(b.relative_to(root))))
     a = parent / name
-    old_text = renamed(a.read_text(), names(parent), names(current), copied)
+    recipe = bool(BUILDS_ON.search((current / "stepper.hpp").read_text()))
+    old_text = renamed(a.read_text(), names(parent), names(current), copied, recipe)
     return list(difflib.unified_diff(old_text.splitlines(keepends=True), new_lines,
                                      fromfile=str(a.relative_to(root)),
                                      tofile=str(b.relative_to(root))))
