@@ -2,8 +2,8 @@
 # library's static archives and a package config under the prefix, so that another project writes
 #   find_package(femcourse 1.0 CONFIG REQUIRED)
 #   target_link_libraries(app PRIVATE femcourse::simulator)
-# and, to read gmsh files, find_package(femcourse CONFIG REQUIRED COMPONENTS mesh_gmsh) and
-# femcourse::mesh_gmsh. The same names work after add_subdirectory (the aliases below).
+# and reads gmsh's .msh files with it (body_from_gmsh_file: the course's own reader, no gmsh
+# SDK). The same names work after add_subdirectory (the aliases below).
 #
 # What the package holds, and what it passes to a consumer:
 #  - headers: femcourse/*.hpp only (the public API; each compiles alone, with the standard
@@ -27,10 +27,8 @@ set_target_properties(fem_steppers PROPERTIES EXPORT_NAME steppers)
 set_target_properties(fem_simulator PROPERTIES EXPORT_NAME simulator)
 set_target_properties(fem_fallbacks PROPERTIES EXPORT_NAME fallbacks)
 add_library(femcourse::simulator ALIAS fem_simulator)
-if(TARGET fem_mesh_gmsh)
-  set_target_properties(fem_mesh_gmsh PROPERTIES EXPORT_NAME mesh_gmsh)
-  add_library(femcourse::mesh_gmsh ALIAS fem_mesh_gmsh)
-endif()
+# The former gmsh reader's name, for an app written against it: the reader is in the library.
+add_library(femcourse::mesh_gmsh ALIAS fem_simulator)
 # Installed, `#include <femcourse/simulator.hpp>` finds include/femcourse/simulator.hpp: no
 # other name lands on the consumer's include path.
 target_include_directories(fem_simulator PUBLIC $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
@@ -63,15 +61,6 @@ install(TARGETS ${FEM_LIBRARY_TARGETS} EXPORT femcourse-targets
 install(DIRECTORY femcourse DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.hpp")
 install(EXPORT femcourse-targets NAMESPACE femcourse:: DESTINATION ${FEM_INSTALL_CMAKEDIR})
-if(TARGET fem_mesh_gmsh)
-  install(TARGETS fem_mesh_gmsh EXPORT femcourse-mesh-gmsh-targets
-          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-  install(EXPORT femcourse-mesh-gmsh-targets NAMESPACE femcourse::
-          DESTINATION ${FEM_INSTALL_CMAKEDIR})
-  set(FEM_PACKAGE_HAS_GMSH ON)
-else()
-  set(FEM_PACKAGE_HAS_GMSH OFF)
-endif()
 set(FEM_PACKAGE_HAS_OPENMP ${OpenMP_CXX_FOUND})
 
 configure_package_config_file(cmake/femcourse-config.cmake.in

@@ -126,9 +126,6 @@ int ArgParser::get_int(const std::string& name) const {
 
 bool ArgParser::has_flag(const std::string& name) const { return options_.at(name).set; }
 
-// help_notice is defined in common/mesh.cpp, beside the mesh code: the gmsh reader sets it, and
-// links in programs without the command line (the library, femcourse::mesh_gmsh).
-
 std::vector<std::string> ArgParser::get_list(const std::string& name) const {
   std::vector<std::string> items;
   std::stringstream list(get(name));
@@ -160,7 +157,6 @@ std::string ArgParser::help() const {
     out << "\n";
   }
   out << "  --help                  print this help and exit\n";
-  if (help_notice) out << "\n" << help_notice << "\n";
   return out.str();
 }
 

@@ -22,10 +22,6 @@ struct UsageError : std::runtime_error {
 std::optional<int> parse_int(const std::string& s);
 std::optional<double> parse_double(const std::string& s);
 
-// The last line of every program's --help, or nullptr: the gmsh reader (common/mesh_gmsh.cpp)
-// sets it, so that a program that links the gmsh SDK says so and under which license.
-extern const char* help_notice;
-
 class ArgParser {
  public:
   ArgParser(std::string program, std::string summary);

@@ -5,13 +5,9 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <sstream>
 
 namespace fem {
-
-// Declared in common/cli.hpp (the last line of --help); defined here, with the mesh code, so that
-// the gmsh reader that sets it links without the course's command line (femcourse::mesh_gmsh).
-extern const char* help_notice;
-const char* help_notice = nullptr;  // constant-initialized: set before any use
 
 namespace {
 
@@ -62,6 +58,22 @@ void refuse_repeated_tets(const std::vector<Eigen::Vector4i>& tets, const std::s
                      " have the same four nodes");
 }
 
+// A tetrahedron's volume is a product of three coordinate differences: beyond 1e100 (the cube
+// root of the largest double is 5.6e102) it overflows to inf, and a far node's edges make every
+// tetrahedron on it look flat. Refused by the node, with its coordinate, before any volume.
+void refuse_huge_coordinates(const Eigen::Matrix3Xd& X, const std::string& name,
+                             const MeshTags& tags) {
+  constexpr double kLargest = 1e100;
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {
+    if (X.col(i).cwiseAbs().maxCoeff() <= kLargest) continue;
+    std::ostringstream at;
+    at << X(0, i) << ", " << X(1, i) << ", " << X(2, i);
+    fail(name, node_name(tags, i) + " lies at (" + at.str() +
+                   "): a coordinate beyond 1e100 overflows a tetrahedron's volume in double "
+                   "precision; give the coordinates in metres");
+  }
+}
+
 void check_arrays(const Eigen::Matrix3Xd& X, const std::vector<Eigen::Vector4i>& tets,
                   const std::string& name, const MeshTags& tags) {
   if (tets.empty())
@@ -71,6 +83,7 @@ void check_arrays(const Eigen::Matrix3Xd& X, const std::vector<Eigen::Vector4i>&
     while (X.col(bad).allFinite()) ++bad;
     fail(name, node_name(tags, bad) + " has a NaN or infinite coordinate");
   }
+  refuse_huge_coordinates(X, name, tags);
   for (std::size_t e = 0; e < tets.size(); ++e)
     for (int i = 0; i < 4; ++i)
       if (tets[e][i] < 0 || tets[e][i] >= X.cols())

@@ -1,4 +1,5 @@
-// A linear tetrahedral mesh read from a gmsh .msh file through the gmsh C++ API.
+// A linear tetrahedral mesh, read from a gmsh .msh file by the course's own reader
+// (common/msh_read.hpp) or made from arrays.
 #pragma once
 
 #include <Eigen/Core>
@@ -25,8 +26,9 @@ struct MeshError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Loads the tetrahedra (gmsh element type 4) of a .msh file. Validates: the file
-// exists and is a mesh, it has tetrahedra, coordinates are finite, no tetrahedron is
+// Loads the tetrahedra (gmsh element type 4) of an ASCII MSH 4.1 or 2.2 file (common/mesh_file.cpp,
+// no gmsh SDK). Validates: the file's structure (common/msh_read.hpp), it has tetrahedra and no
+// other volume element, coordinates are finite and at most 1e100, no tetrahedron is
 // degenerate. Inverted tetrahedra are reoriented and counted; unused nodes dropped.
 TetMesh load_mesh(const std::string& path);
 

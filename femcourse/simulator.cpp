@@ -703,7 +703,7 @@ const fem::State& Body::state() const { return impl().state; }
 const fem::Stepper& Body::stepper() const { return *impl().stepper; }
 
 Body body_from_gmsh_file(const std::string& path, const BodyDescription& description) {
-  fem::TetMesh mesh = fem::load_mesh(path);  // femcourse::mesh_gmsh, else it throws
+  fem::TetMesh mesh = fem::load_mesh(path);  // the course's reader, common/msh_read.cpp
   BodyDescription d = description;
   d.rest_positions.assign(mesh.X.data(), mesh.X.data() + mesh.X.size());
   d.tetrahedra.clear();

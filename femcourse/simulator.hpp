@@ -248,7 +248,8 @@ class Body {
 };
 
 // The body of a gmsh .msh file's tetrahedra; description's arrays are ignored, its other
-// fields used. Needs the femcourse::mesh_gmsh target (gmsh); throws fem::MeshError otherwise.
+// fields used. ASCII MSH 4.1 or 2.2, read by the course's own reader (no gmsh SDK); throws
+// fem::MeshError, naming the line and the cause, for a file it refuses.
 Body body_from_gmsh_file(const std::string& path, const BodyDescription& description);
 
 }  // namespace FEMCOURSE_ABI

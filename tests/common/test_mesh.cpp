@@ -1,6 +1,7 @@
-// Mesh loading through gmsh: the committed test mesh, and every bad input with its
-// clear error message.
+// Mesh loading by the course's own reader (common/msh_read.hpp, no gmsh SDK): the committed
+// test mesh, gmsh's order of the tetrahedra, and every bad input with its clear error message.
 #include <Eigen/LU>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -10,6 +11,7 @@
 
 #include "catch2_compat.hpp"
 #include "common/mesh.hpp"
+#include "common/msh_read.hpp"
 #include "support.hpp"
 
 using namespace fem;
@@ -149,7 +151,7 @@ TEST_CASE("nodes used by no tetrahedron are dropped", "[mesh]") {
   CHECK(mesh.tets[0] == Eigen::Vector4i(0, 1, 2, 3));
 }
 
-// ---- the file's structure, checked before gmsh reads it (common/msh_check.hpp) ------------
+// ---- the file's structure, checked as it is read (common/msh_read.hpp) ----------------------
 namespace {
 
 std::string write_text(const std::string& name, const std::string& text) {
@@ -203,7 +205,7 @@ TEST_CASE("the committed meshes pass the structure check, also with CRLF line en
 TEST_CASE("a node tag defined twice is refused, not the last definition kept", "[mesh]") {
   // MSH 2.2: a ninth line defines tag 7 again, at (0,1,2); gmsh alone keeps it, moves node 7.
   CHECK_THROWS_WITH(load_mesh(write_text("dup22", cube22("9", "8 1 1 1\n7 0 1 2"))),
-                    contains_text("duplicate node tag 7"));
+                    contains_text("duplicate node tag 7 (lines 12 and 14)"));
   // MSH 4.1: the second node's tag line repeats the first's.
   CHECK_THROWS_WITH(load_mesh(write_text("dup41", edited_beam("$Nodes", "\n2\n", "\n1\n"))),
                     contains_text("duplicate node tag 1"));
@@ -313,4 +315,105 @@ TEST_CASE("a path that names no mesh file is refused as what it is", "[mesh]") {
                     contains_text("a binary .msh file"));
   CHECK_THROWS_WITH(load_mesh(write_text("v40", edited_beam("", "4.1 0 8", "4 0 8"))),
                     contains_text("MSH version 4: the programs read MSH 4.1 and 2.2"));
+}
+
+// ---- element tags, and the minor cases of the fifth review (A2) -----------------------------
+
+TEST_CASE("a repeated element tag is refused with both lines, across blocks and types", "[mesh]") {
+  // MSH 2.2: tetrahedra tagged 1, 2, 3, 3, 5, 6 (lines 17 to 22): gmsh kept the second 3 only.
+  std::string twice = cube22();
+  twice.replace(twice.find("\n4 4 2"), 6, "\n3 4 2");
+  CHECK_THROWS_WITH(load_mesh(write_text("etag22", twice)),
+                    contains_text("element tag 3 is used twice (lines 19 and 20)"));
+  // A boundary triangle after the tetrahedra reuses tetrahedron 3's tag (line 23).
+  std::string triangle = cube22();
+  triangle.replace(triangle.find("\n6\n"), 3, "\n7\n");
+  triangle.replace(triangle.find("$EndElements"), 0, "3 2 2 0 2 1 2 4\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("etag22_tri", triangle)),
+                    contains_text("element tag 3 is used twice (lines 19 and 23)"));
+  // MSH 4.1: a triangle block before the tetrahedra's, its triangle tagged 7 as a tetrahedron.
+  const std::string blocks = edited_beam("$Elements", "$Elements\n1 434 1 434\n3 1 4 434\n",
+                                         "$Elements\n2 435 1 434\n2 1 2 1\n7 1 2 3\n3 1 4 434\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("etag41", blocks)),
+                    contains_text("element tag 7 is used twice (lines 451 and 459)"));
+}
+
+TEST_CASE("tetrahedra come in gmsh's order: by volume, then by tag (2.2) or as listed (4.1)",
+          "[mesh]") {
+  // MSH 2.2 "tag type 2 physical elementary nodes": volume 2 first in the file, tags unordered.
+  const std::string head = cube22().substr(0, cube22().find("$Elements"));
+  const MshFile file22 = read_msh_file(
+      write_text("order22", head + "$Elements\n4\n9 4 2 0 2 1 2 4 8\n5 4 2 0 1 1 2 8 6\n"
+                                   "2 4 2 0 1 1 3 8 4\n7 4 2 0 2 1 3 7 8\n$EndElements\n"));
+  CHECK(file22.tet_tags == std::vector<std::int64_t>{2, 5, 7, 9});
+  // MSH 4.1: volume 2's block first, its tetrahedra tagged 9 then 3.
+  const MshFile file41 = read_msh_file(write_text(
+      "order41", edited_beam("$Elements", "$Elements\n1 434 1 434\n3 1 4 434\n",
+                             "$Elements\n2 436 1 1000\n3 2 4 2\n999 1 2 3 4\n998 1 2 3 5\n"
+                             "3 1 4 434\n")));
+  REQUIRE(file41.tet_tags.size() == 436);
+  CHECK(file41.tet_tags[0] == 1);
+  CHECK(file41.tet_tags[434] == 999);
+  CHECK(file41.tet_tags[435] == 998);
+}
+
+TEST_CASE("coordinates beyond 1e100 are refused by the node, before a volume overflows", "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh(write_text("far_node", cube22("8", "8 1e300 1 1"))),
+                    contains_text("node 8 (tag in the file) lies at (1e+300, 1, 1)") &&
+                        contains_text("overflows"));
+  auto nodes = kUnitTet;
+  nodes[1] = "1e150 0 0";
+  CHECK_THROWS_WITH(load_mesh(write_msh("far150", nodes, {{4, "1 2 3 4"}})),
+                    contains_text("node 2 (tag in the file) lies at (1e+150, 0, 0)"));
+  // Large but within: the unit tetrahedron scaled by 1e99, a volume of 1.7e296.
+  CHECK(
+      load_mesh(write_msh("far99", {"0 0 0", "1e99 0 0", "0 1e99 0", "0 0 1e99"}, {{4, "1 2 3 4"}}))
+          .num_tets() == 1);
+}
+
+TEST_CASE("an element type gmsh does not define, or of another node count, names line and type",
+          "[mesh]") {
+  CHECK_THROWS_WITH(load_mesh(write_msh("type200", kUnitTet, {{200, "1 2 3 4"}})),
+                    contains_text("line 13: '1 200 2 0 1 1 2 3 4' has element type 200, which "
+                                  "gmsh does not define"));
+  // Type 99 is gmsh's 32-node hexahedron: the line lists 4.
+  CHECK_THROWS_WITH(load_mesh(write_msh("type99", kUnitTet, {{99, "1 2 3 4"}})),
+                    contains_text("of gmsh type 99 lists 4 nodes, not its 32"));
+  CHECK_THROWS_WITH(load_mesh(write_msh("polyhedron", kUnitTet, {{35, "1 2 3 4"}})),
+                    contains_text("element type 35 (a polygon, polyhedron or XFEM element"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("type41", edited_beam("$Elements", "\n3 1 4 434\n", "\n3 1 999 434\n"))),
+      contains_text("line 450: '3 1 999 434' has element type 999, which gmsh does not define"));
+}
+
+TEST_CASE("a coordinate or a node that is not a number is named with its line", "[mesh]") {
+  std::string text = cube22();
+  text.replace(text.find("\n3 0 1 0\n"), 9, "\n3 0 abc 0\n");
+  CHECK_THROWS_WITH(load_mesh(write_text("text22", text)),
+                    contains_text("line 8: 'abc' in '3 0 abc 0' is not a number (a node's x y z)"));
+  CHECK_THROWS_WITH(
+      load_mesh(write_text("text41", edited_beam("$Nodes", "\n0 0 0.1\n", "\n0 0 0.1x\n"))),
+      contains_text("'0.1x' in '0 0 0.1x' is not a number"));
+  CHECK_THROWS_WITH(load_mesh(write_msh("node_word", kUnitTet, {{4, "1 2 3 four"}})),
+                    contains_text("'four' in '1 4 2 0 1 1 2 3 four' is not an integer"));
+  CHECK_THROWS_WITH(load_mesh(write_msh("node_99", kUnitTet, {{4, "1 2 3 99"}})),
+                    contains_text("line 13: element 1 refers to node 99, which the $Nodes "
+                                  "section does not define"));
+}
+
+TEST_CASE("elements before nodes, CR line ends and a bad format line are named as such", "[mesh]") {
+  const std::string cube = cube22();
+  const auto nodes_at = cube.find("$Nodes"), elements_at = cube.find("$Elements");
+  const std::string swapped = cube.substr(0, nodes_at) + cube.substr(elements_at) +
+                              cube.substr(nodes_at, elements_at - nodes_at);
+  CHECK_THROWS_WITH(load_mesh(write_text("elements_first", swapped)),
+                    contains_text("line 4: $Elements before $Nodes"));
+  std::string cr = cube;
+  std::replace(cr.begin(), cr.end(), '\n', '\r');
+  CHECK_THROWS_WITH(load_mesh(write_text("cr_only", cr)),
+                    contains_text("the file's lines end in CR alone"));
+  std::string garbage = cube;
+  garbage.replace(garbage.find("2.2 0 8"), 7, "abc");
+  CHECK_THROWS_WITH(load_mesh(write_text("format_garbage", garbage)),
+                    contains_text("line 2: 'abc' is not 'version file-type data-size'"));
 }

@@ -1,6 +1,6 @@
 #!/bin/bash
 # No program sizes memory by a mesh file's header before checking it against the file's size
-# (common/msh_check.hpp): under `ulimit -v` at what the program needs to run the committed test
+# (common/msh_read.hpp): under `ulimit -v` at what the program needs to run the committed test
 # mesh plus twice the bad file's size and a fixed margin, a file of a few hundred bytes whose
 # header claims a billion nodes or elements is refused with the count named, not a
 # std::bad_alloc (a 327-byte file once took 20 GiB of the machine before gmsh gave up).
