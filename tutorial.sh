@@ -413,7 +413,7 @@ setup_venv() {
   rm -f "$rest"
   gmsh_pin=$(sed -n 's/^\(gmsh==[^ ]*\).*/\1/p' requirements.txt)
   if ! "${pip[@]}" --only-binary gmsh "$gmsh_pin" 2>/dev/null; then
-    echo "tutorial.sh: PyPI has no wheel of $gmsh_pin for $(uname -s) $(uname -m): the set-up goes on without gmsh. The committed meshes (meshes/*.msh) serve every chapter, test and benchmark; what cannot be made here is a new mesh (./tutorial.sh meshes, the large beams of ./tutorial.sh scaling)." >&2
+    echo "tutorial.sh: pip could not install $gmsh_pin on $(uname -s) $(uname -m) (PyPI has no wheel of it for Linux on arm64): the set-up goes on without gmsh. The committed meshes (meshes/*.msh) serve every chapter, test and benchmark; what cannot be made here is a new mesh (./tutorial.sh meshes, the large beams of ./tutorial.sh scaling)." >&2
   fi
   "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps -e tools/
   echo "$want" >"$stamp"
