@@ -312,7 +312,7 @@ install_with_apt() {
   [ -n "$install" ] || return 0
   required=$(names_of required "$@")
   if [ "$(id -u)" -ne 0 ]; then
-    ask_root "sudo apt-get install -y $install" "$required"
+    ask_root "sudo apt-get install -y ${install% }" "$required"
     return 0
   fi
   log "installing Debian packages: $install"
@@ -326,7 +326,7 @@ install_with_dnf() {
   required=$(names_of required "$@")
   optional=$(names_of optional "$@")
   if [ "$(id -u)" -ne 0 ]; then
-    ask_root "sudo dnf install -y $required$optional" "$required"
+    ask_root "sudo dnf install -y $(echo $required$optional)" "$required"
     return 0
   fi
   if [ -n "${required// /}" ]; then
