@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One entry point for the tutorial: set-up, build, tests, benchmark, simulation.
 # Every subcommand sets up what is missing first (idempotent), so a fresh clone of the
-# repository on Debian 12 needs nothing but this script.
+# repository on Debian or Ubuntu (apt), Fedora (dnf) or macOS (Homebrew) needs nothing but this
+# script (and, without root, the one install line it prints).
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -9,30 +10,58 @@ cd "$ROOT"
 PRESET="${PRESET:-release}"           # release | debug | asan | clang | catch2-3
 BUILD_DIR="$ROOT/build/$PRESET"
 VENV="$ROOT/.venv"
+SKIPPED_PACKAGES="$ROOT/build/.packages-skipped"  # optional packages this system's sources lack
 
+# The system packages, per package manager: apt (Debian, Ubuntu), dnf (Fedora), Homebrew
+# (macOS). Each has a list the build cannot do without and optional groups, each named with
+# what its absence costs: a platform that lacks one (likwid on arm64 and macOS, the viewer's
+# libraries) installs the rest and says what is skipped.
 APT_PACKAGES=(
-  build-essential cmake ninja-build git python3 python3-venv
+  build-essential cmake ninja-build git python3 python3-venv pkg-config
   # the compiler cache: a build folder, a copy of the repository (the coursework tests) or
   # another preset compiles only what it compiles differently (CMakeLists.txt)
   ccache
   libeigen3-dev catch2
   # CHOLMOD, for the supernodal Cholesky row of fem_bench's solve table (Eigen's CholmodSupport)
   libsuitesparse-dev
-  # JSON written and read in C++ (header-only); likwid-bench, the independent check of the
-  # roofline's bandwidth and peak (fem_lessons roofline)
-  nlohmann-json3-dev likwid
-  # gmsh's runtime libraries (the PyPI wheel links against them)
-  libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1 libgomp1
-  # the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
-  # screenshots; Xvfb and Mesa's software renderer run it headless in the tests
-  pkg-config libglfw3-dev libgl-dev libimgui-dev libstb-dev xvfb xauth libgl1-mesa-dri
+  # JSON written and read in C++ (header-only); OpenMP's runtime
+  nlohmann-json3-dev libgomp1
 )
+# likwid-bench, the independent check of the roofline's bandwidth and peak (fem_lessons
+# roofline): Debian and Ubuntu package it for x86-64 only.
+APT_LIKWID=(likwid)
+APT_PYTHON=(python3 python3-venv)
+# gmsh's runtime libraries (the PyPI wheel links against them)
+APT_GMSH=(libglu1-mesa libgl1 libxrender1 libxcursor1 libxft2 libxinerama1 libfontconfig1)
+# the viewer: GLFW, OpenGL, Dear ImGui (with its GLFW and OpenGL 3 backends), stb for the
+# screenshots; Xvfb and Mesa's software renderer run it headless in the tests
+APT_VIEWER=(libglfw3-dev libgl-dev libimgui-dev libstb-dev xvfb xauth libgl1-mesa-dri)
+# Fedora (catch-devel is Catch2 3; json-devel is nlohmann-json).
+DNF_PACKAGES=(gcc-c++ cmake ninja-build git python3 pkgconf-pkg-config ccache eigen3-devel
+              catch-devel suitesparse-devel json-devel libgomp)
+DNF_LIKWID=(likwid)
+DNF_PYTHON=(python3)
+DNF_GMSH=(mesa-libGLU mesa-libGL libXrender libXcursor libXft libXinerama fontconfig)
+DNF_VIEWER=(glfw-devel mesa-libGL-devel xorg-x11-server-Xvfb xorg-x11-xauth mesa-dri-drivers)
+# macOS: Apple's Clang with Homebrew's OpenMP runtime; Homebrew has no likwid (it reads Intel
+# and AMD counters under Linux), and gmsh's macOS wheel carries its own libraries.
+BREW_PACKAGES=(cmake ninja ccache python pkg-config eigen catch2 suite-sparse nlohmann-json libomp)
+BREW_VIEWER=(glfw)
+BREW_PYTHON=(python)
+# What is lost without each optional group.
+COST_LIKWID="no check of the roofline's roofs against likwid-bench (fem_lessons roofline runs without it and says so)"
+COST_GMSH="no gmsh for generating meshes (./tutorial.sh meshes): the committed meshes serve"
+COST_VIEWER="no interactive viewer (fem_viewer) nor its headless tests"
 # What the other presets add: the clang preset builds with Clang and its OpenMP runtime (and
 # brings clang-format, which keeps the sources in .clang-format's style: CI checks it); the
 # catch2-3 preset unpacks Catch2 3 from bookworm-backports into build/ (tools/catch2_3.sh,
 # which installs nothing).
 case "$PRESET" in
-  clang) APT_PACKAGES+=(clang clang-format libomp-dev) ;;
+  clang)
+    APT_PACKAGES+=(clang clang-format libomp-dev)
+    DNF_PACKAGES+=(clang clang-tools-extra libomp-devel)
+    BREW_PACKAGES+=(clang-format)
+    ;;
 esac
 
 usage() {
@@ -40,7 +69,8 @@ usage() {
 usage: ./tutorial.sh <command> [arguments passed to the program]
 
 commands:
-  setup      install what is missing (Debian packages, .venv with requirements.txt), configure, build
+  setup      install what is missing (system packages with apt, dnf or brew; .venv with
+             requirements.txt), configure, build
   build      set up if needed and build (preset: \$PRESET, default release); one build at a time
              in a build folder: a command that builds while another does waits for it, saying so
   test       build and run every test through ctest but the new-chapter test, which builds a
@@ -116,57 +146,244 @@ environment:
                  Clang; catch2-3: tested with Catch2 3, fetched into build/deps/ by
                  tools/catch2_3.sh; CMakePresets.json)
   FEM_SKIP_PACKAGES=1
-                 do not check or install system packages (for systems without apt-get, once
-                 their packages are installed by hand: README, "Other systems")
+                 do not check or install system packages (for systems without apt-get, dnf
+                 or brew, once their packages are installed by hand: docs/reference.md,
+                 "Other systems")
 USAGE
 }
 
 log() { printf '\033[1m==> %s\033[0m\n' "$*"; }
 
-# The Debian packages among the arguments (default: all of APT_PACKAGES) that are missing.
-missing_packages() {
-  local p
-  [ $# -gt 0 ] || set -- "${APT_PACKAGES[@]}"
-  for p in "$@"; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || echo "$p"
-  done
+# The system's package manager: apt (Debian, Ubuntu), dnf (Fedora), brew (macOS), or none.
+package_manager() {
+  if command -v apt-get >/dev/null && command -v dpkg-query >/dev/null; then echo apt
+  elif command -v dnf >/dev/null && command -v rpm >/dev/null; then echo dnf
+  elif command -v brew >/dev/null; then echo brew
+  else echo none
+  fi
 }
 
-# Where there is no apt-get (Fedora, macOS, ...), the script cannot install anything: it says
-# so, with the packages to install by hand, and stops.
-refuse_without_apt() {
+# packages_of PM GROUP: the packages of one group (required, python, likwid, gmsh, viewer), from
+# the arrays above (APT_PACKAGES, APT_LIKWID, ...; bash 3.2, macOS's, has no namerefs).
+packages_of() {
+  local name
+  name=$(printf '%s_%s' "$1" "$2" | tr '[:lower:]' '[:upper:]')
+  name=${name/%_REQUIRED/_PACKAGES}
+  eval "echo \${$name[*]:-}"
+}
+
+cost_of() {
+  case "$1" in
+    likwid) echo "$COST_LIKWID" ;;
+    gmsh) echo "$COST_GMSH" ;;
+    viewer) echo "$COST_VIEWER" ;;
+  esac
+}
+
+# The command that installs every package of a system, optional groups included.
+install_line() {
+  local all
+  all="$(packages_of "$1" required) $(packages_of "$1" likwid) $(packages_of "$1" gmsh) $(packages_of "$1" viewer)"
+  all=$(echo $all)  # one space between names
+  case "$1" in
+    apt) echo "sudo apt-get install -y $all" ;;
+    dnf) echo "sudo dnf install -y $all" ;;
+    brew) echo "brew install $all" ;;
+  esac
+}
+
+installed() {  # installed PM PACKAGE
+  case "$1" in
+    apt) dpkg-query -W -f='${Status}' "$2" 2>/dev/null | grep -q "install ok installed" ;;
+    dnf) rpm -q --whatprovides "$2" >/dev/null 2>&1 ;;
+    brew) brew list --versions "$2" >/dev/null 2>&1 ;;
+  esac
+}
+
+# Whether apt's lists (as they are) have a candidate for the package on this architecture.
+apt_available() {
+  local candidate
+  candidate=$(apt-cache policy "$1" 2>/dev/null | awk '/Candidate:/ { print $2 }')
+  [ -n "$candidate" ] && [ "$candidate" != "(none)" ]
+}
+
+# Without a package manager it knows, the script cannot install anything: it says so, with
+# the complete line for each system it knows, and stops.
+refuse_without_package_manager() {
   cat >&2 <<REFUSE
-tutorial.sh installs its system packages with apt-get (Debian, Ubuntu), and this system has
-no apt-get. Install them by hand (README, "Other systems"), for example:
-  Fedora:           sudo dnf install gcc-c++ cmake ninja-build git python3 eigen3-devel \\
-                      catch-devel suitesparse-devel glfw-devel mesa-libGL-devel \\
-                      xorg-x11-server-Xvfb mesa-dri-drivers
-  macOS (Homebrew): brew install cmake ninja python eigen catch2 libomp glfw
-then run the same command again with FEM_SKIP_PACKAGES=1, e.g.
+tutorial.sh installs its system packages with apt-get (Debian, Ubuntu), dnf (Fedora) or brew
+(macOS), and this system has none of them. Install them by hand (docs/reference.md, "Other
+systems"); on those systems the lines are:
+  Debian, Ubuntu:   $(install_line apt)
+  Fedora:           $(install_line dnf)
+  macOS (Homebrew): $(install_line brew)
+(likwid has no package for arm64 nor macOS, and the viewer's libraries are optional: without
+them the rest builds, and what is missing is named.) Then run the same command again with
+FEM_SKIP_PACKAGES=1, e.g.
   FEM_SKIP_PACKAGES=1 ./tutorial.sh test
-(CMake then reports anything still missing; the viewer is built only where Dear ImGui and stb
-are found, and is skipped otherwise.)
+(CMake then reports anything still missing.)
 REFUSE
   exit 1
 }
 
-# Installs the missing ones of the arguments (default: all of APT_PACKAGES).
+# Installs what is missing of the required packages and of each optional group (default), or of
+# Python's alone (argument python). A required package that cannot be installed stops the script
+# with the line to run; an optional group that cannot is skipped, named with what it costs.
 install_system_packages() {
   [ "${FEM_SKIP_PACKAGES:-0}" = 1 ] && return 0
-  command -v apt-get >/dev/null && command -v dpkg-query >/dev/null || refuse_without_apt
-  local missing
-  missing=$(missing_packages "$@" | tr '\n' ' ')
-  [ -z "${missing// /}" ] && return 0
-  if [ "$(id -u)" -eq 0 ]; then
-    log "installing Debian packages: $missing"
-    export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq
-    # shellcheck disable=SC2086
-    apt-get install -y -qq --no-install-recommends $missing
-  else
-    echo "Missing Debian packages. Please run:" >&2
-    echo "  sudo apt-get install -y $missing" >&2
+  local pm groups=(required likwid gmsh viewer)
+  pm=$(package_manager)
+  [ "$pm" = none ] && refuse_without_package_manager
+  [ "${1:-}" = python ] && groups=(python)
+  local group p missing=() skipped=""
+  # Optional packages found missing from this system's sources once are not looked up again.
+  [ -f "$SKIPPED_PACKAGES" ] && skipped=$(cat "$SKIPPED_PACKAGES")
+  for group in "${groups[@]}"; do
+    for p in $(packages_of "$pm" "$group"); do
+      [[ " $skipped " == *" $group:$p "* ]] && continue
+      installed "$pm" "$p" || missing+=("$group:$p")
+    done
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  case "$pm" in
+    apt) install_with_apt "${missing[@]}" ;;
+    dnf) install_with_dnf "${missing[@]}" ;;
+    brew) install_with_brew "${missing[@]}" ;;
+  esac
+}
+
+# The names of the GROUP:NAME arguments of one group ("required" or "optional").
+names_of() {
+  local kind=$1 entry
+  shift
+  for entry in "$@"; do
+    case "$kind:${entry%%:*}" in
+      required:required | required:python | optional:likwid | optional:gmsh | optional:viewer)
+        printf '%s ' "${entry#*:}" ;;
+    esac
+  done
+}
+
+say_skipped() {  # say_skipped GROUP WHY [PACKAGES]: PACKAGES default to the whole group
+  local names=${3:-$(packages_of "$PM_NOW" "$1")}
+  echo "tutorial.sh: skipped ${names% } ($2): without it, $(cost_of "$1")" >&2
+}
+
+# Without root, the script prints the line to run: it stops when a required package is missing,
+# and goes on when only optional ones are.
+ask_root() {  # ask_root COMMAND REQUIRED_MISSING
+  echo "Missing system packages. Please run:" >&2
+  echo "  $1" >&2
+  if [ -n "${2// /}" ]; then
     echo "then run ./tutorial.sh again." >&2
+    exit 1
+  fi
+  echo "(optional packages: the rest is built without them)" >&2
+}
+
+install_with_apt() {
+  local entry p install="" required unavailable="" skipped="" group
+  PM_NOW=apt
+  [ "$(id -u)" -eq 0 ] && { DEBIAN_FRONTEND=noninteractive apt-get update -qq || true; }
+  # One name apt does not know would abort the whole install: each is looked up first.
+  for entry in "$@"; do
+    p=${entry#*:}
+    if apt_available "$p"; then
+      install+="$p "
+    elif [[ "$entry" == required:* || "$entry" == python:* ]]; then
+      unavailable+="$p "
+    else
+      skipped+="$entry "
+    fi
+  done
+  for group in likwid gmsh viewer; do
+    p=$(printf '%s\n' $skipped | sed -n "s/^$group://p" | tr '\n' ' ')
+    [ -z "$p" ] || say_skipped "$group" "apt has none for $(uname -m) in this system's sources" "$p"
+  done
+  if [ -n "$skipped" ]; then
+    mkdir -p "$(dirname "$SKIPPED_PACKAGES")"
+    echo "$skipped" >>"$SKIPPED_PACKAGES"
+  fi
+  if [ -n "$unavailable" ]; then
+    echo "tutorial.sh: apt has no package $unavailable(needed to build; on Ubuntu enable universe: sudo add-apt-repository universe)." >&2
+    echo "The complete line: $(install_line apt)" >&2
+    exit 1
+  fi
+  [ -n "$install" ] || return 0
+  required=$(names_of required "$@")
+  if [ "$(id -u)" -ne 0 ]; then
+    ask_root "sudo apt-get install -y ${install% }" "$required"
+    return 0
+  fi
+  log "installing Debian packages: $install"
+  # shellcheck disable=SC2086
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $install
+}
+
+install_with_dnf() {
+  local required optional group
+  PM_NOW=dnf
+  required=$(names_of required "$@")
+  optional=$(names_of optional "$@")
+  if [ "$(id -u)" -ne 0 ]; then
+    ask_root "sudo dnf install -y $(echo $required$optional)" "$required"
+    return 0
+  fi
+  if [ -n "${required// /}" ]; then
+    log "installing Fedora packages: $required"
+    # shellcheck disable=SC2086
+    dnf install -y $required || {
+      echo "tutorial.sh: dnf could not install them; the complete line: $(install_line dnf)" >&2
+      exit 1
+    }
+  fi
+  # Each optional group alone: one that dnf lacks is skipped, the others install.
+  for group in likwid gmsh viewer; do
+    printf '%s\n' "$@" | grep -q "^$group:" || continue
+    # shellcheck disable=SC2046
+    dnf install -y $(packages_of dnf "$group") || say_skipped "$group" "dnf could not install it"
+  done
+}
+
+install_with_brew() {
+  local required group
+  PM_NOW=brew
+  required=$(names_of required "$@")
+  if [ -n "${required// /}" ]; then
+    log "installing Homebrew packages: $required"
+    # shellcheck disable=SC2086
+    brew install $required || {
+      echo "tutorial.sh: brew could not install them; the complete line: $(install_line brew)" >&2
+      exit 1
+    }
+  fi
+  for group in viewer; do
+    printf '%s\n' "$@" | grep -q "^$group:" || continue
+    # shellcheck disable=SC2046
+    brew install $(packages_of brew "$group") || say_skipped "$group" "brew could not install it"
+  done
+  # Homebrew has no likwid (it reads Intel's and AMD's counters under Linux): said with the rest.
+  echo "tutorial.sh: Homebrew has no likwid: without it, $COST_LIKWID" >&2
+}
+
+# Portable stand-ins for GNU coreutils (macOS has neither nproc nor sha256sum). A system with
+# none of the fallbacks stops, naming the tool and the line that installs it.
+cores() {
+  nproc 2>/dev/null || getconf _NPROCESSORS_ONLN 2>/dev/null || sysctl -n hw.ncpu 2>/dev/null || {
+    echo "tutorial.sh: cannot count the cores: no nproc, getconf nor sysctl (install coreutils: sudo apt-get install coreutils, sudo dnf install coreutils, brew install coreutils)" >&2
+    exit 1
+  }
+}
+
+sha256() {  # the SHA-256 of standard input, in hex
+  if command -v sha256sum >/dev/null; then
+    sha256sum | cut -d' ' -f1
+  elif command -v shasum >/dev/null; then
+    shasum -a 256 | cut -d' ' -f1
+  elif command -v python3 >/dev/null; then
+    python3 -c 'import hashlib, sys; print(hashlib.sha256(sys.stdin.buffer.read()).hexdigest())'
+  else
+    echo "tutorial.sh: no sha256sum, shasum nor python3 to hash requirements.txt (install coreutils: sudo apt-get install coreutils, sudo dnf install coreutils, brew install coreutils)" >&2
     exit 1
   fi
 }
@@ -180,14 +397,24 @@ tools_installed() {
 setup_venv() {
   local stamp="$VENV/.requirements.sha256"
   local want
-  want=$(cat requirements.txt tools/pyproject.toml | sha256sum | cut -d' ' -f1)
+  want=$(cat requirements.txt tools/pyproject.toml | sha256)
   if [ -x "$VENV/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ] \
     && tools_installed; then
     return 0
   fi
   log "creating .venv and installing requirements.txt (gmsh, matplotlib) and tools/ (fem-tools)"
   [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
-  "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r requirements.txt
+  local pip=("$VENV/bin/python" -m pip install --quiet --disable-pip-version-check) rest gmsh_pin
+  # gmsh apart: PyPI has no wheel of it for every system (none for Linux on arm64), and the
+  # course goes on without it.
+  rest=$(mktemp)
+  grep -v '^gmsh==' requirements.txt >"$rest"
+  "${pip[@]}" -r "$rest"
+  rm -f "$rest"
+  gmsh_pin=$(sed -n 's/^\(gmsh==[^ ]*\).*/\1/p' requirements.txt)
+  if ! "${pip[@]}" --only-binary gmsh "$gmsh_pin" 2>/dev/null; then
+    echo "tutorial.sh: pip could not install $gmsh_pin on $(uname -s) $(uname -m) (PyPI has no wheel of it for Linux on arm64): the set-up goes on without gmsh. The committed meshes (meshes/*.msh) serve every chapter, test and benchmark; what cannot be made here is a new mesh (./tutorial.sh meshes, the large beams of ./tutorial.sh scaling)." >&2
+  fi
   "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps -e tools/
   echo "$want" >"$stamp"
 }
@@ -203,6 +430,11 @@ configure() {
   if [ "$PRESET" = catch2-3 ]; then
     tools/catch2_3.sh >/dev/null
   fi
+  # Apple's Clang has no OpenMP runtime of its own: CMake finds Homebrew's (libomp) there.
+  if [ -z "${OpenMP_ROOT:-}" ] && command -v brew >/dev/null; then
+    OpenMP_ROOT=$(brew --prefix libomp 2>/dev/null || true)
+    export OpenMP_ROOT
+  fi
   if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
     log "configuring (preset $PRESET)"
     cmake --preset "$PRESET"
@@ -215,30 +447,62 @@ setup_python() {
   setup_venv
 }
 
+# The packages first: on a system the script cannot install on, its first words say what to
+# install, whatever else it lacks. Then the lock, then the rest of the set-up under it.
 setup() {
   install_system_packages
+  take_build_lock
   setup_venv
   configure
 }
 
 # One build at a time in a build folder: two commands started together (two benches on a
 # stale build) once ran two ninjas in one folder, and one failed with a linker error that read
-# like a code error. The lock (flock on a file in the build folder, fd 9) covers the set-up,
-# the build and its log; it is released when the build ends, before the programs run, or with
-# the process. The second command waits for it, saying so.
+# like a code error. The lock covers the set-up after the packages, the build and its log; it is
+# released when the build ends, before the programs run, or with the process. The second command
+# waits for it, saying so. flock on a file in the build folder (fd 9) where flock exists (Linux);
+# elsewhere (macOS) a directory, which mkdir makes or fails to make in one step, holding the
+# owner's process id: a lock whose owner no longer runs is taken over.
 take_build_lock() {
   mkdir -p "$BUILD_DIR"
-  exec 9>"$BUILD_DIR/.build.lock"
-  flock -n 9 && return 0
-  echo "another command is building in ${BUILD_DIR#"$ROOT"/}: waiting for its build to end" >&2
-  flock 9
+  if command -v flock >/dev/null; then
+    exec 9>"$BUILD_DIR/.build.lock"
+    flock -n 9 && return 0
+    say_waiting
+    flock 9
+  else
+    LOCK_DIR="$BUILD_DIR/.build.lock.d"
+    local waited=0 owner
+    until mkdir "$LOCK_DIR" 2>/dev/null; do
+      owner=$(cat "$LOCK_DIR/pid" 2>/dev/null || true)
+      if [ -n "$owner" ] && ! kill -0 "$owner" 2>/dev/null; then
+        rm -rf "$LOCK_DIR"
+        continue
+      fi
+      [ "$waited" -eq 1 ] || say_waiting
+      waited=1
+      sleep 1
+    done
+    echo $$ >"$LOCK_DIR/pid"
+    trap release_build_lock EXIT
+    [ "$waited" -eq 1 ] || return 0
+  fi
   echo "the other build ended: building" >&2
 }
 
-release_build_lock() { exec 9>&-; }
+say_waiting() {
+  echo "another command is building in ${BUILD_DIR#"$ROOT"/}: waiting for its build to end" >&2
+}
+
+release_build_lock() {
+  exec 9>&-
+  if [ -n "${LOCK_DIR:-}" ]; then
+    rm -rf "$LOCK_DIR"
+    LOCK_DIR=""
+  fi
+}
 
 build() {
-  take_build_lock
   setup
   log "building (preset $PRESET)"
   cmake --build --preset "$PRESET"
@@ -270,7 +534,6 @@ build_progress() {
 # The build with its log kept out of the way of the results that follow: ninja's progress, the
 # log's tail on failure, and the warnings (if any) named.
 quiet_build() {
-  take_build_lock
   setup
   local build_log="$BUILD_DIR/build.log"
   log "building (preset $PRESET; log in ${build_log#"$ROOT"/})"
@@ -293,7 +556,7 @@ run_tests() {
   # out unless the arguments name it or exclude labels of their own (.ci/run runs it apart).
   local select=(-LE new-chapter)
   [[ "$*" == *new-chapter* || " $* " == *" -LE "* ]] && select=()
-  ctest --preset "$PRESET" -j "$(nproc)" "${select[@]}" "$@" 2>&1 | with_heartbeat
+  ctest --preset "$PRESET" -j "$(cores)" ${select[@]+"${select[@]}"} "$@" 2>&1 | with_heartbeat
   return "${PIPESTATUS[0]}"
 }
 
@@ -391,7 +654,7 @@ threads() {
   quiet_build
   mkdir -p results
   local counts
-  counts=$(seq -s, 1 "$(nproc)")
+  counts=$(seq -s, 1 "$(cores)")
   log "chapter 09 at $counts threads (chapter 08 beside it, one thread) on the poster-sized mesh"
   "$BUILD_DIR/fem_bench" --chapters 08,09 --threads "$counts" --no-solvers \
     --json results/threads.json --replace "$@"
@@ -512,12 +775,13 @@ viewer_bench() {
 # chapter's data come from; ctest -L docs fails once a chapter's code differs from them).
 book_quiet_check() {
   local load cores
-  read -r load _ </proc/loadavg
-  cores=$(nproc)
+  load=$(cut -d' ' -f1 /proc/loadavg 2>/dev/null || sysctl -n vm.loadavg | awk '{ print $2 }')
+  cores=$(cores)
   # Busy: a 1-minute load above a quarter of the cores (one helper compiling is far above it).
   if awk -v l="$load" -v c="$cores" 'BEGIN { exit !(l > c / 4) }'; then
     echo "tutorial.sh book: the machine is not quiet (1-minute load $load on $cores cores); what runs:" >&2
-    ps -eo pcpu=,pid=,args= --sort=-pcpu | awk '$1 > 2' | head -n 8 >&2
+    { ps -eo pcpu=,pid=,args= --sort=-pcpu 2>/dev/null || ps -Arco pcpu=,pid=,args=; } |
+      awk '$1 > 2' | head -n 8 >&2
     echo "stop it and try again, or pass --busy to record anyway (the data will say so)" >&2
     exit 1
   fi
@@ -579,6 +843,10 @@ book() {
 
 meshes() {
   setup_python
+  if ! "$VENV/bin/python" -c "import gmsh" 2>/dev/null; then
+    echo "tutorial.sh meshes: gmsh is not installed in .venv (PyPI has no wheel of it for $(uname -s) $(uname -m)): new meshes cannot be generated here; the committed ones in meshes/ serve every chapter, test and benchmark" >&2
+    exit 1
+  fi
   "$VENV/bin/python" meshes/generate.py "$@"
 }
 
@@ -586,7 +854,7 @@ main() {
   cmd="${1:-help}"
   [ $# -gt 0 ] && shift
   case "$cmd" in
-    setup) take_build_lock; setup ;;
+    setup) setup ;;
     build) build ;;
     test) run_tests "$@" ;;
     bench) bench "$@" ;;

@@ -2,9 +2,10 @@
 // claim this project asserts, so it needs a counter that sees every allocation.
 //
 // It interposes malloc, calloc, realloc, free, posix_memalign, aligned_alloc and memalign
-// (forwarding to glibc's __libc_* functions) and replaces the global operator new and
-// delete, so that both of Eigen's sources of memory are seen: dense storage comes from
-// malloc (or its aligned variants), sparse storage from new[] and std::malloc.
+// (forwarding to the C library's own, found with dlsym(RTLD_NEXT): glibc, musl and macOS
+// alike) and replaces the global operator new and delete, so that both of Eigen's sources of
+// memory are seen: dense storage comes from std::malloc (Eigen/src/Core/util/Memory.h:
+// aligned_malloc, which has no hook of its own), sparse storage from new[] and std::malloc.
 //
 // Why not Eigen's own EIGEN_RUNTIME_NO_MALLOC? It only guards Eigen's dense
 // aligned_malloc (SparseMatrix and CompressedStorage allocate with new[] and std::realloc,

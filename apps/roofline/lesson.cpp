@@ -45,6 +45,15 @@ std::vector<Roofs> machine_roofs(const LessonRun& run) {
   return roofs;
 }
 
+// Why the roofs have no likwid-bench check: not asked for, or likwid-bench's own note (not
+// installed, as on arm64 and macOS, or no report), so that a run without it says so.
+std::string unchecked_why(const std::vector<Roofs>& roofs) {
+  const std::string note = roofs.empty() || roofs.front().levels.empty()
+                               ? std::string()
+                               : roofs.front().levels.front().likwid_read.note;
+  return note.empty() ? "likwid-bench's check not asked for (--no-likwid)" : note;
+}
+
 // How a roof was sampled: beside its likwid-bench check where that ran (measure_roofs).
 std::string sampling(const std::vector<Roofs>& roofs, double seconds) {
   const bool checked = !roofs.empty() && !roofs.front().levels.empty() &&
@@ -56,7 +65,8 @@ std::string sampling(const std::vector<Roofs>& roofs, double seconds) {
         << kRoofRounds << " rounds, the best of each (likwid-bench one process a thread, "
         << "each pinned to its CPU, started at once, their rates summed)";
   else
-    out << "the best of repeated timings in " << kRoofRounds << " rounds";
+    out << "the best of repeated timings in " << kRoofRounds
+        << " rounds, unchecked: " << unchecked_why(roofs);
   return out.str();
 }
 

@@ -98,7 +98,9 @@ LikwidRate likwid_bench(LikwidKernel kernel, std::size_t bytes_per_thread, int t
   int status = 0;
   if (run("command -v likwid-bench >/dev/null 2>&1 && echo yes", status).find("yes") ==
       std::string::npos) {
-    r.note = "likwid-bench not installed (Debian: likwid)";
+    r.note =
+        "likwid-bench not installed (Debian and Ubuntu on x86-64: likwid; no package for arm64 "
+        "nor macOS)";
     return r;
   }
   const bool flops = kernel == LikwidKernel::peak;
