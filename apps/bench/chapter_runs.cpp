@@ -17,7 +17,6 @@ namespace {
 // One chapter's stepper, state and samples while the benchmark runs.
 struct RunningChapter {
   int threads = 1;
-  ExecutedWork (*executed)(const Stepper&) = nullptr;  // the chapter's record of what ran
   std::unique_ptr<Stepper> stepper;
   State state;
   std::array<std::vector<double>, StepProfile::kPhaseCount> ms;
@@ -36,7 +35,6 @@ std::vector<RunningChapter> make_runs(const std::vector<const ChapterInfo*>& cha
     for (const int threads : threaded ? thread_counts : std::vector<int>{1}) {
       RunningChapter run;
       run.threads = threads;
-      run.executed = threaded ? c->work.executed : nullptr;
       run.stepper = first ? std::move(first) : c->make(scene, solver);
       run.state = rest_state(scene);
       run.result.chapter = threaded ? c->id + "@" + std::to_string(threads) : c->id;
@@ -71,7 +69,8 @@ void step(RunningChapter& run, int k, bool measured) {
   run.allocations.push_back(static_cast<double>(allocs));
   r.allocations_max = std::max(r.allocations_max, allocs);
   run.iterations.push_back(p.cg_iterations);
-  if (const int team = run.executed ? static_cast<int>(run.executed(*run.stepper).team) : 0) {
+  // The stepper's own record of the threads its step ran on (0: it does not say).
+  if (const int team = run.stepper->uses_threads() ? run.stepper->threads_used() : 0) {
     r.threads_fewest = r.threads_fewest == 0 ? team : std::min(r.threads_fewest, team);
     r.threads_most = std::max(r.threads_most, team);
   }

@@ -262,7 +262,8 @@ struct Members {
       has_inward<Order>::value && has_outward<Order>::value && has_outward_forces<Order>::value;
   static constexpr bool team_built = std::is_default_constructible_v<Team>;
   static constexpr bool team_run = has_run<Team>::value;
-  static constexpr bool team_threads = has_threads_flag<Team>::value && has_threads_used<Team>::value;
+  static constexpr bool team_threads =
+      has_threads_flag<Team>::value && has_threads_used<Team>::value;
   static constexpr bool elements_built = built<Elements>();
   static constexpr bool elements_start = has_start_system<Elements>::value;
   static constexpr bool elements_pass = has_pass<Elements>::value;

@@ -108,7 +108,7 @@ TEST_CASE("chapter 06 from the registry runs on one thread when OpenMP has two",
 
 TEST_CASE("the registry lists each variant right after its original", "[registry]") {
   const auto info = [](std::string id, std::string variant_of) {
-    return ChapterInfo{std::move(id), "", {}, std::move(variant_of), nullptr, "", {}, {}};
+    return ChapterInfo{std::move(id), "", {}, std::move(variant_of), "", {}};
   };
   // "10_mine" sorts before "10_multigrid" by name, and must still come after it.
   const auto sorted = detail::in_course_order(
