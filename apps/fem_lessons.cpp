@@ -144,6 +144,18 @@ void check_chapter_lists(const ArgParser& args) {
   }
 }
 
+// The lesson's run, and its copy in the variant --chapter names, after the original's.
+std::vector<std::pair<const ChapterInfo*, Lesson>> lesson_runs(const Found& found,
+                                                               const ArgParser& args) {
+  std::vector<std::pair<const ChapterInfo*, Lesson>> runs = {{found.chapter, found.lesson}};
+  if (const std::string id = found.chapter ? args.get("chapter") : ""; !id.empty()) {
+    const ChapterInfo& variant = find_chapter(id);
+    if (variant.id != found.chapter->id)
+      runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
+  }
+  return runs;
+}
+
 // Runs one lesson; argv[0] is its name. A variant's table is printed after the original's.
 int run_lesson(const Found& found, int argc, char** argv) {
   const std::string program = "fem_lessons " + found.lesson.name;
@@ -169,12 +181,7 @@ int run_lesson(const Found& found, int argc, char** argv) {
     const Scene scene = scene_from_args(args);
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
-    std::vector<std::pair<const ChapterInfo*, Lesson>> runs = {{found.chapter, found.lesson}};
-    if (const std::string id = found.chapter ? args.get("chapter") : ""; !id.empty()) {
-      const ChapterInfo& variant = find_chapter(id);
-      if (variant.id != found.chapter->id)
-        runs.push_back({&variant, lesson_of(variant, found.lesson.name)});
-    }
+    const std::vector<std::pair<const ChapterInfo*, Lesson>> runs = lesson_runs(found, args);
     const std::string& readme = args.get("readme");
     const std::string& json = args.get("json");
     if ((!readme.empty() || !json.empty()) && runs.size() > 1)

@@ -300,9 +300,9 @@ constexpr bool recipe_is_whole() {
     return false;
 }
 
-// Each missing role or member of `Recipe` as one static_assert sentence naming both.
+// Each missing role of `Recipe` as one static_assert sentence naming it.
 template <class Recipe>
-constexpr bool check_recipe() {
+constexpr bool check_roles() {
   using namespace recipe_checks;
   static_assert(has_order<Recipe>::value, "Recipe: no Order (using Order = ...;)");
   static_assert(has_team<Recipe>::value, "Recipe: no Team (using Team = ...;)");
@@ -312,6 +312,14 @@ constexpr bool check_recipe() {
   static_assert(has_preconditioner<Recipe>::value,
                 "Recipe: no Preconditioner (using Preconditioner = ...;)");
   static_assert(has_solver<Recipe>::value, "Recipe: no Solver (using Solver = ...;)");
+  return true;
+}
+
+// Each missing role or member of `Recipe` as one static_assert sentence naming both.
+template <class Recipe>
+constexpr bool check_recipe() {
+  using namespace recipe_checks;
+  static_assert(check_roles<Recipe>());
   if constexpr (recipe_has_roles<Recipe>()) {
     using M = Members<Recipe>;
     static_assert(M::names[0], "Order part: no kName or kChapter");

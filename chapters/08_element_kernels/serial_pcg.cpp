@@ -1,5 +1,5 @@
-// Chapter 07's block PCG (block_pcg.cpp), its product and its preconditioner called through
-// their faces.
+// Chapter 08's serial PCG: chapter 07's block PCG (block_pcg.cpp), its product and its
+// preconditioner called through their faces.
 #include "chapters/08_element_kernels/serial_pcg.hpp"
 
 #include <algorithm>

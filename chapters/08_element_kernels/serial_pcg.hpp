@@ -1,7 +1,8 @@
-// Chapter 07's PCG with its product and its preconditioner as parts: the same loop, the same
-// stopping rule and PPCG filter, but q = A p and s = M r are whatever the recipe names, through
-// the two faces of contract.hpp. With chapter 08's AssembledProduct and BlockJacobi it runs
-// chapter 07's arithmetic, operation for operation: the same bits as ch07::pcg_solve.
+// Chapter 08's serial PCG: chapter 07's loop with its product and its preconditioner as parts: the
+// same loop, the same stopping rule and PPCG filter, but q = A p and s = M r are whatever the
+// recipe names, through the two faces of contract.hpp. With chapter 08's AssembledProduct and
+// BlockJacobi it runs chapter 07's arithmetic, operation for operation: the same bits as
+// ch07::pcg_solve.
 #pragma once
 
 #include <Eigen/Core>
