@@ -39,6 +39,8 @@ import tempfile
 from exercises import EXERCISES, LESSONS, STANDS_FOR
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+from femtools.course.variant import rewrite  # noqa: E402 (the path above first)
 results = {"passed": 0, "failed": 0}
 
 
@@ -127,7 +129,12 @@ def make_variants(repo, env):
             continue
         for change in ex["change"]:
             file, old, new = change if len(change) == 3 else ("stepper.cpp", *change)
-            source = repo / "chapters" / f"{ex['chapter']}_{ex['name']}" / file
+            # Written in the original's names, as the README writes them; the student edits the
+            # copy, whose own namespace and includes carry the variant's name.
+            original = course_chapter(repo, ex["chapter"]).name
+            variant = f"{ex['chapter']}_{ex['name']}"
+            old, new = (rewrite(t, original, variant, ex["chapter"]) for t in (old, new))
+            source = repo / "chapters" / variant / file
             text = source.read_text()
             check(f"{ex['id']}: the code the exercise changes is there ({file}: {old.strip()[:50]})",
                   old in text, source)

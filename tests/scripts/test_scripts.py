@@ -205,8 +205,9 @@ def main():
         readme = (root / "README.md").read_text()
         check("README headline filled", markdown.ms(last["median_ms"]["step"]) in readme)
         check("results.md viewer table filled",
-              "| drawing only (`--paused`) | 31.2 | - |" in results_md and "llvmpipe (fixture)" in results_md and
-              all(f"| `{r['chapter']}` | {r['frames_per_second']:.1f} | {markdown.ms(r['mean_step_ms'])} |"
+              "| drawing only (`--paused`) | - | 31.2 | - |" in results_md and "llvmpipe (fixture)" in results_md and
+              all(f"| `{r['chapter']}` | {format(r['threads'], 'g') if 'threads' in r else '-'} | "
+                  f"{r['frames_per_second']:.1f} | {markdown.ms(r['mean_step_ms'])} |"
                   in results_md for r in viewer["runs"][1:]), results_md[results_md.find("viewer-fps"):][:600])
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()

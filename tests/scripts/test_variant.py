@@ -108,18 +108,25 @@ def main():
               p.returncode == 2 and "usage: ./tutorial.sh variant NN NAME" in p.stderr, p.stderr)
 
         # The registry the build would generate.
-        generated = repo / "chapter_list.cpp"
-        p = run("cmake", f"-DSOURCE_DIR={repo}", f"-DOUTPUT={generated}", "-P",
-                repo / "chapters" / "registry.cmake")
-        check("registry.cmake generates the list", p.returncode == 0 and generated.exists(), p.stderr)
+        # The two lists: the steppers (the library's) and the course's hooks by id.
+        generated, course = repo / "chapter_list.cpp", repo / "course_list.cpp"
+        outputs = [f"-DOUTPUT={generated}", f"-DCOURSE_OUTPUT={course}"]
+        p = run("cmake", f"-DSOURCE_DIR={repo}", *outputs, "-P", repo / "chapters" / "registry.cmake")
+        check("registry.cmake generates the lists",
+              p.returncode == 0 and generated.exists() and course.exists(), p.stderr)
         text = generated.read_text() if generated.exists() else ""
+        hooks = course.read_text() if course.exists() else ""
         check("the variant is registered with its original",
               'chapter<fem::ch06_my_fused_updates::CustomPcgStepper>("06_my_fused_updates", '
-              '"a variant of 06_custom_pcg (' in text and '"06_custom_pcg", nullptr,' in text, text)
+              '"a variant of 06_custom_pcg (our own preconditioned conjugate gradient)", "06_custom_pcg"'
+              in text, text)
         check("the originals keep their entries",
               'chapter<fem::ch06::CustomPcgStepper>("06_custom_pcg"' in text
-              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "", nullptr,' in text
-              and '"", &fem::ch08::lessons,' in text, text)
+              and 'chapter<fem::ch01::NaiveStepper>("01_naive", "the naive stepper", "",' in text, text)
+        check("the course list names each chapter's hooks, the variant's too",
+              'course<fem::ch01::NaiveStepper>("01_naive", nullptr)' in hooks
+              and 'course<fem::ch08::ElementKernelsStepper>("08_element_kernels", &fem::ch08::lessons)'
+              in hooks and '"06_my_fused_updates"' in hooks, hooks)
         # Each entry ends with the hash of its chapter's sources, as the hand-in check computes it.
         check("each entry records its chapter's source hash",
               f'"{check_handin.source_hash(variant)}"' in text
@@ -128,7 +135,7 @@ def main():
         # Original and variant compile side by side (no clash of names), the variant's own file too.
         flags = ["-std=c++17", "-fsyntax-only", f"-I{repo}", *[f"-I{i}" for i in args.include],
                  "-DFEM_SOURCE_DIR=\"/\""]
-        for source in (generated, variant / "stepper.cpp"):
+        for source in (generated, course, variant / "stepper.cpp"):
             p = run(args.cxx, *flags, source)
             check(f"{source.name} of the variant compiles", p.returncode == 0, p.stderr)
 
@@ -137,8 +144,7 @@ def main():
         broken.mkdir()
         (broken / "stepper.hpp").write_text("namespace fem::ch08 {\nstruct Nothing {};\n}\n")
         (broken / "README.md").write_text("# Chapter 08: broken\n")
-        p = run("cmake", f"-DSOURCE_DIR={repo}", f"-DOUTPUT={generated}", "-P",
-                repo / "chapters" / "registry.cmake")
+        p = run("cmake", f"-DSOURCE_DIR={repo}", *outputs, "-P", repo / "chapters" / "registry.cmake")
         check("a chapter without a stepper class is refused with the rule",
               p.returncode != 0 and "chapters/08_broken" in p.stderr and "public Stepper" in p.stderr,
               p.stderr)
