@@ -89,15 +89,9 @@ void ReducedVCycle<Real>::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
     multigrid_.apply(fine_, coarse_, r, s);
   } else {
     const std::vector<int>& part = fine_.source->rows.part;
-    ch09::for_parts(part, true, [&](int first, int last) {
-      r_.segment(3 * first, 3 * (last - first)) =
-          r.segment(3 * first, 3 * (last - first)).template cast<float>();
-    });
+    ch09::for_parts(part, true, [&](int first, int last) { convert_rows(r, r_, first, last); });
     multigrid_.apply(fine_, coarse_, r_, s_);
-    ch09::for_parts(part, true, [&](int first, int last) {
-      s.segment(3 * first, 3 * (last - first)) =
-          s_.segment(3 * first, 3 * (last - first)).template cast<double>();
-    });
+    ch09::for_parts(part, true, [&](int first, int last) { convert_rows(s_, s, first, last); });
   }
 }
 

@@ -89,6 +89,15 @@ class ReducedVCycle {
   std::atomic<bool> converted_{false};
 };
 
+// The float V-cycle's entry and exit on the rows [first, last) of 3-vectors: r into float, or
+// s back into double (ReducedVCycle::apply, chapter 14's LaneVCycle::apply, and the roofline's
+// kernel alone).
+template <class To, class From>
+void convert_rows(const From& from, To& to, int first, int last) {
+  const int f = 3 * first, size = 3 * (last - first);
+  to.segment(f, size) = from.segment(f, size).template cast<typename To::Scalar>();
+}
+
 extern template class ReducedVCycle<float>;
 extern template class ReducedVCycle<double>;
 

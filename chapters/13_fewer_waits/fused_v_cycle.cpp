@@ -27,16 +27,14 @@ bool FusedVCycle::fused() const {
 }
 
 void FusedVCycle::enter(int first, int last, const Eigen::VectorXd& r) {
-  r_.segment(3 * first, 3 * (last - first)) =
-      r.segment(3 * first, 3 * (last - first)).cast<float>();
+  ch12::convert_rows(r, r_, first, last);
   fused_entry(reduced_.fine_level(), first, last, r_);
 }
 
 void FusedVCycle::complete(Eigen::VectorXd& s, const RowsCall& finish) {
   multigrid_.refresh_rule().count_cycle();  // the refresh rule counts V-cycles
   fused_cycle(reduced_.fine_level(), reduced_.coarse_levels(), 0, r_, s_, [&](int first, int last) {
-    s.segment(3 * first, 3 * (last - first)) =
-        s_.segment(3 * first, 3 * (last - first)).cast<double>();
+    ch12::convert_rows(s_, s, first, last);
     finish(first, last);
   });
 }

@@ -81,7 +81,7 @@ std::vector<PartKernel> solver_kernels(SingleReductionSolver&, const ch08::Kerne
 
 std::vector<PartKernel> preconditioner_kernels(FusedPreconditioner& part,
                                                const ch08::KernelInput& in) {
-  return ch12::smoothing_kernels(part.reduced().v_cycle(), part.multigrid(), in);
+  return ch12::preconditioner_kernels(part.reduced(), in);
 }
 
 }  // namespace fem::ch13

@@ -41,15 +41,9 @@ void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
     return;
   }
   const std::vector<int>& part = reduced_.fine_level().source->rows.part;
-  ch09::for_parts(part, true, [&](int first, int last) {
-    r_.segment(3 * first, 3 * (last - first)) =
-        r.segment(3 * first, 3 * (last - first)).cast<float>();
-  });
+  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(r, r_, first, last); });
   with_fine_level([&](auto& fine) { multigrid_.apply(fine, reduced_.coarse_levels(), r_, s_); });
-  ch09::for_parts(part, true, [&](int first, int last) {
-    s.segment(3 * first, 3 * (last - first)) =
-        s_.segment(3 * first, 3 * (last - first)).cast<double>();
-  });
+  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(s_, s, first, last); });
 }
 
 }  // namespace fem::ch14

@@ -5,6 +5,7 @@
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/10_multigrid/smoothers.hpp"
 #include "chapters/10_multigrid/work.hpp"
+#include "chapters/12_half_the_bytes/work.hpp"
 
 namespace fem::ch14 {
 
@@ -62,7 +63,7 @@ std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::
   if (!cycle.lanes()) return {};
   return cycle.with_fine_level([&](auto& fine) {
     const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
-    return std::vector<PartKernel>{ch09::part_kernel(
+    std::vector<PartKernel> kernels{ch09::part_kernel(
         "fine smoothing step (float, pair lanes)", "level 0 smoothing and residual",
         fine.smoothing_work(), in.passes * ch10::smoother_products(part.multigrid()),
         [&fine, step] {
@@ -71,6 +72,12 @@ std::vector<PartKernel> preconditioner_kernels(LaneMultigrid& part, const ch08::
             smooth_rows(fine, step, first, last, v.b, &v.x, v.y);
           });
         })};
+    // Below it, chapter 12's levels: the fine level's transfers, the coarse levels.
+    for (PartKernel& k : ch12::below_fine_kernels(fine, part.reduced().v_cycle().coarse_levels(),
+                                                  part.multigrid(), true, in))
+      kernels.push_back(std::move(k));
+    kernels.push_back(ch12::entry_and_exit_kernel(source_level(fine).rows.part, in));
+    return kernels;
   });
 }
 
