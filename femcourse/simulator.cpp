@@ -212,7 +212,9 @@ struct Body::Impl {
   Eigen::Vector3d grab_velocity = Eigen::Vector3d::Zero();
   bool floor_on = false;
   Eigen::Vector3d floor_point = Eigen::Vector3d::Zero(), floor_normal = Eigen::Vector3d::UnitZ();
+  double floor_friction = 0.0;
   std::vector<int> contacts;
+  std::vector<int> stuck;   // the contacts friction holds still, sorted
   std::vector<char> owned;  // per node: has a constraint of its own
   std::vector<std::array<int, 3>> surface;
   // The forces' model, made on first need (reactions, the floor, elastic_forces), and its
@@ -252,11 +254,14 @@ struct Body::Impl {
   // that a saved state alone decides what follows.
   void restart_stepper() { rebuild_stepper(); }
   void rebuild_stepper();
-  void replace_contacts(std::vector<int> next);
+  void replace_contacts(std::vector<int> next, std::vector<int> next_stuck = {});
+  bool is_stuck(int node) const { return std::binary_search(stuck.begin(), stuck.end(), node); }
   const Eigen::VectorXd& model_forces() const;  // elastic + gravity at state.x
   Eigen::Vector3d reaction(int node) const;
   void sub_step();
   void update_floor();
+  bool release_pulled_contacts();
+  bool apply_friction();
   void warn_if_impact_inverts();
   void check_restorable(const BodyState& saved) const;
   static void receive_warning(void* self, const std::string& message);
@@ -267,10 +272,12 @@ struct Body::Impl {
     if (team > 0) return team;
     return stepper->uses_threads() ? fem::max_threads() : 1;
   }
-  void set_floor(bool on, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+  void set_floor(bool on, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                 double friction) {
     floor_on = on;
     floor_point = point;
     floor_normal = normal;
+    floor_friction = friction;
   }
 };
 
@@ -279,7 +286,9 @@ std::vector<fem::NodeConstraint> Body::Impl::compose_constraints() const {
   for (const fem::NodeConstraint& c : own)
     if (!is_grabbed(c.node)) all.push_back(c);
   for (const int node : grabbed) all.push_back(fem::NodeConstraint::fixed(node, grab_velocity));
-  for (const int node : contacts) all.push_back(fem::NodeConstraint::plane(node, floor_normal));
+  for (const int node : contacts)
+    all.push_back(is_stuck(node) ? fem::NodeConstraint::fixed(node)
+                                 : fem::NodeConstraint::plane(node, floor_normal));
   return all;
 }
 
@@ -306,13 +315,17 @@ void Body::Impl::rebuild_stepper() {
   stepper = std::move(rebuilt);
 }
 
-// The floor's contacts, and the constraints with them; a throw leaves both as they were.
-void Body::Impl::replace_contacts(std::vector<int> next) {
+// The floor's contacts (those of them that stick), and the constraints with them; a throw
+// leaves them as they were.
+void Body::Impl::replace_contacts(std::vector<int> next, std::vector<int> next_stuck) {
+  std::sort(next_stuck.begin(), next_stuck.end());
   std::swap(contacts, next);
+  std::swap(stuck, next_stuck);
   try {
     apply_constraints(compose_constraints());
   } catch (...) {
     std::swap(contacts, next);
+    std::swap(stuck, next_stuck);
     throw;
   }
 }
@@ -343,17 +356,60 @@ Eigen::Vector3d Body::Impl::reaction(int node) const {
          scene.damping.alpha * m.cwiseProduct(v);
 }
 
-// The floor's active set after a step: contacts whose floor pulls are let go, free nodes
-// below it are put on it with their velocity into it removed.
+// Contacts whose floor pulls are let go; true when one was. model_forces() must be current.
+bool Body::Impl::release_pulled_contacts() {
+  const auto pulling = [&](int node) { return reaction(node).dot(floor_normal) < 0.0; };
+  const auto end = std::remove_if(contacts.begin(), contacts.end(), pulling);
+  if (end == contacts.end()) return false;
+  contacts.erase(end, contacts.end());
+  const auto gone = [&](int node) {
+    return std::find(contacts.begin(), contacts.end(), node) == contacts.end();
+  };
+  stuck.erase(std::remove_if(stuck.begin(), stuck.end(), gone), stuck.end());
+  return true;
+}
+
+// Coulomb friction on the contacts that stay (set_floor): a stuck contact whose tangential
+// reaction exceeds friction * R_n slides from the next step; a sliding one loses along the
+// floor what the push can take in a step, friction * R_n * dt / m, and sticks when that stops
+// it. True when a contact changed between the two. model_forces() must be current; each
+// node's reaction is taken before its velocity changes (reaction reads it).
+bool Body::Impl::apply_friction() {
+  if (floor_friction == 0.0) return false;
+  bool changed = false;
+  for (const int node : contacts) {
+    const Eigen::Vector3d r = reaction(node);
+    const double push = std::max(0.0, r.dot(floor_normal));
+    if (is_stuck(node)) {
+      if ((r - push * floor_normal).norm() <= floor_friction * push) continue;
+      stuck.erase(std::lower_bound(stuck.begin(), stuck.end(), node));
+      changed = true;
+      continue;
+    }
+    auto v = state.v.segment<3>(3 * node);
+    const Eigen::Vector3d along = v - floor_normal.dot(v) * floor_normal;
+    const double speed = along.norm(), mass = model->lumped_mass[3 * node];
+    const double loss = floor_friction * push * scene.dt / mass;
+    if (loss < speed) {
+      v -= (loss / speed) * along;
+      continue;
+    }
+    v -= along;
+    stuck.insert(std::upper_bound(stuck.begin(), stuck.end(), node), node);
+    changed = true;
+  }
+  return changed;
+}
+
+// The floor's active set after a step: contacts whose floor pulls are let go, friction on the
+// others, free nodes below it put on it with their velocity into it removed.
 void Body::Impl::update_floor() {
   if (!floor_on) return;
   bool changed = false, landed = false;
   if (!contacts.empty()) {
     model_forces();
-    const auto pulling = [&](int node) { return reaction(node).dot(floor_normal) < 0.0; };
-    const auto end = std::remove_if(contacts.begin(), contacts.end(), pulling);
-    changed = end != contacts.end();
-    contacts.erase(end, contacts.end());
+    changed = release_pulled_contacts();
+    changed = apply_friction() || changed;
   }
   for (int node = 0; node < scene.mesh.num_nodes(); ++node) {
     const auto n = static_cast<std::size_t>(node);
@@ -519,13 +575,14 @@ void Body::grab(const std::vector<int>& nodes, const std::array<double, 3>& velo
   std::vector<int> grabbed = nodes;
   std::sort(grabbed.begin(), grabbed.end());
   grabbed.erase(std::unique(grabbed.begin(), grabbed.end()), grabbed.end());
-  std::vector<int> contacts = b.contacts;  // a grabbed node leaves the floor
-  contacts.erase(
-      std::remove_if(contacts.begin(), contacts.end(),
-                     [&](int n) { return std::binary_search(grabbed.begin(), grabbed.end(), n); }),
-      contacts.end());
+  // A grabbed node leaves the floor.
+  const auto held = [&](int n) { return std::binary_search(grabbed.begin(), grabbed.end(), n); };
+  std::vector<int> contacts = b.contacts, stuck = b.stuck;
+  contacts.erase(std::remove_if(contacts.begin(), contacts.end(), held), contacts.end());
+  stuck.erase(std::remove_if(stuck.begin(), stuck.end(), held), stuck.end());
   std::swap(b.grabbed, grabbed);
   std::swap(b.contacts, contacts);
+  std::swap(b.stuck, stuck);
   const Eigen::Vector3d previous_velocity = b.grab_velocity;
   b.grab_velocity = vector_of(velocity);
   try {
@@ -533,6 +590,7 @@ void Body::grab(const std::vector<int>& nodes, const std::array<double, 3>& velo
   } catch (...) {
     std::swap(b.grabbed, grabbed);
     std::swap(b.contacts, contacts);
+    std::swap(b.stuck, stuck);
     b.grab_velocity = previous_velocity;
     throw;
   }
@@ -546,16 +604,24 @@ void Body::move_grabbed(const std::array<double, 3>& velocity) {
 void Body::release() { grab({}); }
 const std::vector<int>& Body::grabbed() const { return impl().grabbed; }
 
-void Body::set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal) {
+void Body::set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal,
+                     double friction) {
   Impl& b = impl();
   const Eigen::Vector3d p = vector_of(point), n = vector_of(normal);
   if (!p.allFinite() || !n.allFinite() || !(n.norm() > 0.0))
     refuse("set_floor: the point and the normal must be finite, the normal not zero");
+  if (!std::isfinite(friction) || friction < 0.0)
+    refuse("set_floor: the friction coefficient must be finite and not negative, not " +
+           std::to_string(friction));
   // A floor moved or tilted under a resting body lets its contacts go: the next step finds
-  // them against the new plane (held on the old one, they would stay where it was).
+  // them against the new plane (held on the old one, they would stay where it was). Without
+  // friction no contact sticks.
   const bool moved = b.floor_on && (p != b.floor_point || n.normalized() != b.floor_normal);
-  if (moved && !b.contacts.empty()) b.replace_contacts({});
-  b.set_floor(true, p, n.normalized());
+  if (moved && !b.contacts.empty())
+    b.replace_contacts({});
+  else if (friction == 0.0 && !b.stuck.empty())
+    b.replace_contacts(b.contacts);
+  b.set_floor(true, p, n.normalized(), friction);
 }
 
 void Body::remove_floor() {
@@ -622,7 +688,9 @@ BodyState Body::save_state() {
           b.contacts,
           b.floor_on,
           array(b.floor_point),
-          array(b.floor_normal)};
+          array(b.floor_normal),
+          b.floor_friction,
+          b.stuck};
 }
 
 namespace {
@@ -655,6 +723,19 @@ void Body::Impl::check_restorable(const BodyState& saved) const {
     refuse(
         "restore_state: the state's floor point and normal must be finite, the normal not "
         "zero");
+  if (saved.floor && (!std::isfinite(saved.floor_friction) || saved.floor_friction < 0.0))
+    refuse("restore_state: the state's floor friction must be finite and not negative");
+  std::vector<int> stuck = saved.floor_stuck;
+  std::sort(stuck.begin(), stuck.end());
+  for (std::size_t k = 0; k < stuck.size(); ++k) {
+    const int node = stuck[k];
+    if (std::find(saved.floor_contacts.begin(), saved.floor_contacts.end(), node) ==
+        saved.floor_contacts.end())
+      refuse("restore_state: a stuck floor contact, " + node_name(node) +
+             ", is not among the floor contacts");
+    if (k > 0 && stuck[k - 1] == node)
+      refuse("restore_state: the stuck floor contacts name " + node_name(node) + " twice");
+  }
   std::vector<char> seen(static_cast<std::size_t>(nodes), 0);
   for (const int node : saved.floor_contacts) {
     check_node(node, nodes, "restore_state: a floor contact");
@@ -672,12 +753,14 @@ void Body::restore_state(const BodyState& saved) {
   b.check_restorable(saved);
   const bool was_on = b.floor_on;
   const Eigen::Vector3d point = b.floor_point, normal = b.floor_normal;
+  const double friction = b.floor_friction;
   b.set_floor(saved.floor, vector_of(saved.floor_point),
-              saved.floor ? vector_of(saved.floor_normal).normalized() : normal);
+              saved.floor ? vector_of(saved.floor_normal).normalized() : normal,
+              saved.floor ? saved.floor_friction : friction);
   try {
-    b.replace_contacts(saved.floor_contacts);
+    b.replace_contacts(saved.floor_contacts, saved.floor_stuck);
   } catch (...) {
-    b.set_floor(was_on, point, normal);
+    b.set_floor(was_on, point, normal, friction);
     throw;
   }
   b.restart_stepper();  // as save_state did: no history of the steps since

@@ -124,6 +124,8 @@ struct BodyState {
   // back, or removes the body's floor when the state has none.
   bool floor = false;
   std::array<double, 3> floor_point{0.0, 0.0, 0.0}, floor_normal{0.0, 0.0, 1.0};
+  double floor_friction = 0.0;   // set_floor's Coulomb coefficient
+  std::vector<int> floor_stuck;  // the contacts that stick (friction), among floor_contacts
 };
 
 // The deformation watch (fem_sim's): an element stretched to several times its rest size, or
@@ -183,14 +185,21 @@ class Body {
   void move_grabbed(const std::array<double, 3>& velocity);
   void release();  // the grabbed nodes get their own constraints back
   const std::vector<int>& grabbed() const;
-  // A one-sided, frictionless floor: the plane through `point` with normal `normal` (pointing
-  // to where the body may go). A free node that ends a step below it is put on it, its
-  // velocity into it removed, and held on it until the floor would have to pull it back (its
-  // reaction points into the floor): then it is released. Nodes with constraints of their own
-  // or grabbed are left alone. Called again (a moving or tilting platform), it lets the contacts
-  // go and the next step finds them against the new plane. Throws std::invalid_argument for a
-  // zero or non-finite normal.
-  void set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal);
+  // A one-sided floor: the plane through `point` with normal `normal` (pointing to where the
+  // body may go). A free node that ends a step below it is put on it, its velocity into it
+  // removed, and held on it until the floor would have to pull it back (its reaction points
+  // into the floor): then it is released. Nodes with constraints of their own or grabbed are
+  // left alone. Called again (a moving or tilting platform), it lets the contacts go and the
+  // next step finds them against the new plane. Throws std::invalid_argument for a zero or
+  // non-finite normal, or a negative or non-finite friction.
+  //
+  // Coulomb friction with coefficient `friction` (0: frictionless, a released body glides on):
+  // a sliding contact's velocity along the floor loses, after each step, what the floor's push
+  // R_n can take in one, friction * R_n * dt / m, and sticks when that stops it; a stuck
+  // contact is held still (its reaction has a tangential part R_t) and slides again once
+  // |R_t| > friction * R_n. The kinetic and the static coefficient are the same.
+  void set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal,
+                 double friction = 0.0);
   void remove_floor();
   const std::vector<int>& floor_contacts() const;
   bool changes_constraints_in_place() const;
