@@ -12,6 +12,7 @@
 #include "common/model.hpp"
 #include "femcourse/simulator.hpp"
 #include "support.hpp"
+#include "test_beam.hpp"
 
 namespace {
 
@@ -23,12 +24,8 @@ const Eigen::Vector3d kNormal(std::sin(kSlope), 0.0, std::cos(kSlope));
 
 // The test beam, free, with some mass damping (as the library's floor tests).
 BodyDescription free_beam() {
-  const fem::Scene scene = fem::test::test_scene("cantilever");
-  BodyDescription d;
-  const auto& X = scene.mesh.X;
-  d.rest_positions.assign(X.data(), X.data() + X.size());
-  for (const auto& t : scene.mesh.tets)
-    d.tetrahedra.insert(d.tetrahedra.end(), t.data(), t.data() + 4);
+  BodyDescription d = fem::test::clamped_beam_description();
+  d.constraints.clear();
   d.damping_alpha = 2.0;
   return d;
 }

@@ -17,6 +17,7 @@
 #include "common/stepper.hpp"
 #include "femcourse/simulator.hpp"
 #include "support.hpp"
+#include "test_beam.hpp"
 
 namespace {
 
@@ -25,13 +26,7 @@ using femcourse::BodyDescription;
 
 // The test beam (nodes at min x clamped, gravity -z) as arrays.
 BodyDescription beam(const std::string& chapter = "") {
-  const fem::Scene scene = fem::test::test_scene("cantilever");
-  BodyDescription d;
-  const auto& X = scene.mesh.X;
-  d.rest_positions.assign(X.data(), X.data() + X.size());
-  for (const auto& t : scene.mesh.tets)
-    d.tetrahedra.insert(d.tetrahedra.end(), t.data(), t.data() + 4);
-  for (const auto& c : scene.constraints) d.constraints.push_back({c.node});
+  BodyDescription d = fem::test::clamped_beam_description();
   d.chapter = chapter;
   return d;
 }

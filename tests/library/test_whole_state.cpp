@@ -13,6 +13,7 @@
 #include "common/threads.hpp"
 #include "femcourse/simulator.hpp"
 #include "support.hpp"
+#include "test_beam.hpp"
 
 namespace {
 
@@ -21,16 +22,7 @@ using femcourse::BodyDescription;
 using femcourse::BodyState;
 
 // The test beam (nodes at min x fixed, gravity -z) as arrays.
-BodyDescription clamped_beam() {
-  const fem::Scene scene = fem::test::test_scene("cantilever");
-  BodyDescription d;
-  const auto& X = scene.mesh.X;
-  d.rest_positions.assign(X.data(), X.data() + X.size());
-  for (const auto& t : scene.mesh.tets)
-    d.tetrahedra.insert(d.tetrahedra.end(), t.data(), t.data() + 4);
-  for (const auto& c : scene.constraints) d.constraints.push_back({c.node});
-  return d;
-}
+BodyDescription clamped_beam() { return fem::test::clamped_beam_description(); }
 
 // The same beam with nothing holding it: it falls onto a floor.
 BodyDescription free_beam() {
