@@ -18,8 +18,13 @@ struct Weights {
 // Row i of the polynomial step from its product `sum` (unused from zero): d = alpha d + beta
 // D^-1 (b - sum), out = in + d, with the new d kept in registers (written as `d = ...;
 // out = in + d` the compiler must read d back, out might be d: a store and a load on the
-// row's chain). The update is one multiply-add and a multiply: which multiply the compiler
-// fuses depends on the code around it, so it may round differently from the V-cycle's own.
+// row's chain). The update is one multiply-add and a multiply. Written as `alpha * d + beta
+// * t`, the compiler chooses which multiply to fuse with the add from the code around it, so
+// that each layout of the blocks rounded it its own way; the multiply-add is spelled out
+// (Eigen's pmadd: one fused instruction where the target has FMA, else a multiply and an add
+// no compiler can fuse), so that every layout computes the same bits and the stepper may
+// choose one by speed alone (it may still round differently from the V-cycle's own generic
+// step, which leaves the choice to the compiler).
 template <class Blocks>
 void update_row(LaneLevel<Blocks>& level, int i, const Eigen::Vector3f& sum, const Weights& w,
                 const Eigen::VectorXf& b, const Eigen::VectorXf* in, Eigen::VectorXf& out) {
@@ -27,8 +32,9 @@ void update_row(LaneLevel<Blocks>& level, int i, const Eigen::Vector3f& sum, con
   if (in) r -= sum;
   auto d = level.vectors.direction.template segment<3>(3 * i);
   const Eigen::Vector3f t = times_inverse_diagonal(level, i, r);
-  const Eigen::Vector3f next =
-      w.restart ? Eigen::Vector3f(w.beta * t) : Eigen::Vector3f(w.alpha * d + w.beta * t);
+  Eigen::Vector3f next = w.beta * t;
+  if (!w.restart)
+    for (int j = 0; j < 3; ++j) next[j] = Eigen::internal::pmadd(w.alpha, d[j], next[j]);
   d = next;
   if (in)
     out.segment<3>(3 * i) = in->segment<3>(3 * i) + next;
@@ -78,8 +84,10 @@ EIGEN_ALWAYS_INLINE void update_row4(LaneLevel<Blocks>& level, int i, const Eige
   const Packet4f t = inverse_times(level.level.smoother.inverse_diagonal[i].data(), r);
   float* d = level.vectors.direction.data() + 3 * i;
   const Packet4f scaled = pmul(pset1<Packet4f>(w.beta), t);
+  // The fused multiply-add spelled out, as in update_row (an FMA target's one instruction;
+  // without FMA, Eigen's pmadd is a multiply and an add, which no compiler can fuse then).
   const Packet4f next =
-      w.restart ? scaled : padd(pmul(pset1<Packet4f>(w.alpha), ploadu<Packet4f>(d)), scaled);
+      w.restart ? scaled : pmadd(pset1<Packet4f>(w.alpha), ploadu<Packet4f>(d), scaled);
   store3(d, next);
   store3(out.data() + 3 * i, in ? padd(ploadu<Packet4f>(in->data() + 3 * i), next) : next);
 }

@@ -1,5 +1,8 @@
 #include "chapters/14_every_lane/lane_v_cycle.hpp"
 
+#include <algorithm>
+#include <chrono>
+
 #include "chapters/09_threads/parallel.hpp"
 #include "chapters/10_multigrid/v_cycle.hpp"
 
@@ -7,32 +10,93 @@ namespace fem::ch14 {
 
 namespace {
 
-std::variant<InCacheLanes, FromMemoryLanes> fine_lanes(ch12::ReducedLevel<float, 3>& level,
-                                                       long long cache_bytes) {
-  InCacheLanes padded(level);
-  if (padded.smoothing_work().working_set <= double(cache_bytes)) return padded;
-  return FromMemoryLanes(level);
+int team_size() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+// Each thread fills the row blocks it smooths (the same static share of the same parts).
+template <class Lanes>
+void fill(Lanes& fine) {
+  ch09::for_parts(source_level(fine).rows.part, true,
+                  [&](int first, int last) { fine.fill(first, last); });
+}
+
+// The wall time of `sweeps` smoothing steps over the level's rows on this team, after one
+// untimed to bring its data to where the V-cycle finds them; step 1 from x, as the V-cycle
+// runs most. Every thread returns the time thread 0 took from barrier to barrier. The level's
+// direction and y are overwritten (the V-cycle's first step writes both afresh).
+template <class Lanes>
+double smoothing_seconds(Lanes& fine, int sweeps) {
+  auto& v = fine.vectors;
+  const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
+  const auto sweep = [&] {
+    ch09::for_parts(source_level(fine).rows.part, true, [&](int first, int last) {
+      smooth_rows(fine, step, first, last, v.b, &v.x, v.y);
+    });
+  };
+  sweep();
+  static double seconds;  // shared by the team: written by one thread, read after a barrier
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < sweeps; ++k) sweep();
+  ch09::on_one_thread(true, [&] {
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
+  return seconds;
 }
 
 }  // namespace
 
 LaneVCycle::LaneVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& multigrid,
-                       long long cache_bytes)
+                       std::optional<Layout> forced)
     : reduced_(reduced),
       multigrid_(multigrid),
       lanes_(multigrid.levels() > 1),
-      fine_(fine_lanes(reduced.fine_level(), cache_bytes)),
+      forced_(forced),
+      current_(forced.value_or(Layout::padded)),
+      padded_(reduced.fine_level()),
+      packed_(reduced.fine_level()),
       r_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())),
-      s_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())) {}
+      s_(Eigen::VectorXf::Zero(multigrid.fine_level().dofs())) {
+  measured_.fill(-1);
+}
+
+std::optional<Layout> LaneVCycle::measured(int threads) const {
+  const signed char m = measured_[std::clamp(threads, 1, kTeams)];
+  if (m < 0) return std::nullopt;
+  return Layout(m);
+}
+
+// Three sweeps a layout: on the plate tens of microseconds each, on an 80,000-node beam a few
+// milliseconds, once per team size.
+Layout LaneVCycle::time_layouts() {
+  fill(padded_);
+  fill(packed_);
+  const double padded = smoothing_seconds(padded_, 3), packed = smoothing_seconds(packed_, 3);
+  return packed < padded ? Layout::packed : Layout::padded;
+}
 
 void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A) {
   reduced_.prepare(A);
   if (!lanes_) return;
-  // Each thread fills the row blocks it smooths (the same static share of the same parts).
-  with_fine_level([](auto& fine) {
-    ch09::for_parts(source_level(fine).rows.part, true,
-                    [&](int first, int last) { fine.fill(first, last); });
-  });
+  const int team = std::clamp(team_size(), 1, kTeams);
+  Layout layout = forced_.value_or(Layout::padded);
+  const bool timed = !forced_ && measured_[team] < 0;
+  if (timed) {
+    layout = time_layouts();
+    ch09::on_one_thread(true, [&] { measured_[team] = static_cast<signed char>(layout); });
+  } else if (!forced_) {
+    layout = Layout(measured_[team]);
+  }
+  ch09::on_one_thread(true, [&] { current_ = layout; });
+  if (timed) return;  // both filled
+  if (layout == Layout::padded)
+    fill(padded_);
+  else
+    fill(packed_);
 }
 
 void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {

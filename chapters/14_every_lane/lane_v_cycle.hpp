@@ -4,65 +4,76 @@
 // blocks after each factorization, and the V-cycle (chapter 10's v_cycle.hpp) runs on it
 // through the level's own kernels, found by argument-dependent lookup.
 //
-// Which layout depends on where the level will live. In cache, the kernel is held in the core
-// and the padded pairs are the faster (a pair's column is one load, 48 bytes a block); from
-// memory a kernel held by its bytes would favour the packed pairs, chapter 12's 36 bytes. The
-// choice is made once, from the level's size against the last cache the machine reports,
-// never from the thread count: the same bits on any number of threads. That rule is a
-// measurement, not a law: the lesson's table (`fem_lessons every-lane`) times both layouts at
-// one and two threads and says where the stepper runs the slower one.
+// Which layout is faster is a measurement, not a rule. Padded pairs (a pair's column one load,
+// 48 bytes a block) take fewer instructions; packed pairs (36 bytes a block, chapter 12's)
+// read fewer bytes. Which wins depends on the caches, the memory and the thread count: the
+// book's recordings found the padded pairs faster on one machine and the packed on another
+// for the same level, and the two orders swapped between one thread and two. The layouts
+// compute the same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the
+// stepper times a few smoothing steps in each at its first prepare on each team size and runs
+// the faster: the state does not depend on the choice, only the time.
 #pragma once
 
 #include <Eigen/Core>
-#include <variant>
+#include <array>
+#include <optional>
 
 #include "chapters/09_threads/parallel_pcg.hpp"
 #include "chapters/10_multigrid/multigrid.hpp"
 #include "chapters/12_half_the_bytes/reduced_v_cycle.hpp"
 #include "chapters/14_every_lane/fine_smoothing.hpp"
-#include "common/caches.hpp"
 
 namespace fem::ch14 {
 
-// The finest level's layouts: a row's blocks in pairs, one pair per 256 bits of float, padded
-// where the level fits in the last cache, packed where it does not (the README's layout lines
-// say, per mesh and thread count, which one measured faster); RowPairFineLevel puts two rows'
+// The finest level's two layouts the stepper chooses from: a row's blocks in pairs, one pair
+// per 256 bits of float, padded or packed; RowPairFineLevel (row_pairs.hpp) puts two rows'
 // pairs in 512 bits.
-using InCacheLanes = LaneFineLevel;
-using FromMemoryLanes = PackedFineLevel;
+using PaddedLanes = LaneFineLevel;
+using PackedLanes = PackedFineLevel;
+enum class Layout : signed char { padded, packed };
 
 class LaneVCycle {
  public:
-  // Both must outlive this object; `reduced` reads `multigrid`'s levels. The finest level is
-  // padded when a smoothing step's data fit in `cache_bytes` (by default the last cache the
-  // machine reports; 0 where it does not say: packed).
+  // Both must outlive this object; `reduced` reads `multigrid`'s levels. `forced`: run that
+  // layout on every team (the tests); without, each team size runs the one it measured faster.
   LaneVCycle(ch12::ReducedVCycle<float>& reduced, ch10::Multigrid& multigrid,
-             long long cache_bytes = last_cache_bytes());
+             std::optional<Layout> forced = std::nullopt);
 
   // Chapter 12's prepare (chapter 10's factorize, its numbers into float), then the finest
-  // level's double blocks into the lanes. By every thread.
+  // level's double blocks into the layout this team size runs (both, and the timing, the
+  // first time on it). By every thread.
   void prepare(const ch07::BlockSparseMatrix& A);
   // s = M r: one float V-cycle from the lanes' finest level. By every thread.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // A hierarchy of one level is its coarsest, solved by chapter 10's Cholesky factor: no lanes.
   bool lanes() const { return lanes_; }
-  bool in_cache() const { return std::holds_alternative<InCacheLanes>(fine_); }
-  // f(the finest level in its layout).
+  // The layout the last prepare filled, which apply runs.
+  Layout layout() const { return current_; }
+  // The layout measured faster on a team of `threads`, if one has prepared.
+  std::optional<Layout> measured(int threads) const;
+  // f(the finest level in the layout it runs).
   template <class F>
   decltype(auto) with_fine_level(F&& f) {
-    return std::visit(f, fine_);
+    return current_ == Layout::padded ? f(padded_) : f(packed_);
   }
   template <class F>
   decltype(auto) with_fine_level(F&& f) const {
-    return std::visit(f, fine_);
+    return current_ == Layout::padded ? f(padded_) : f(packed_);
   }
 
  private:
+  static constexpr int kTeams = 64;  // team sizes remembered (a larger one shares the last)
+  Layout time_layouts();             // by every thread: the faster layout on this team
+
   ch12::ReducedVCycle<float>& reduced_;
   ch10::Multigrid& multigrid_;
   bool lanes_;
-  std::variant<InCacheLanes, FromMemoryLanes> fine_;
+  std::optional<Layout> forced_;
+  std::array<signed char, kTeams + 1> measured_;  // per team size: -1, or the faster Layout
+  Layout current_;
+  PaddedLanes padded_;
+  PackedLanes packed_;
   Eigen::VectorXf r_, s_;  // the PCG's residual and its preconditioned residual in float
 };
 

@@ -32,7 +32,9 @@ class LaneMultigrid final : public ch08::PreconditionerPart {
   void describe(std::ostream& out) const {
     reduced_.describe(out);
     if (lanes_.lanes())
-      out << "    finest level in pair lanes, " << (lanes_.in_cache() ? "padded" : "packed") << ": "
+      out << "    finest level in pair lanes, "
+          << (lanes_.layout() == Layout::padded ? "padded" : "packed")
+          << " (the faster of the two, timed on the first step of each team size): "
           << lanes_.with_fine_level([](const auto& fine) { return fine.blocks.bytes(); }) / 1024
           << " KiB\n";
   }

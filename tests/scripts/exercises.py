@@ -111,7 +111,7 @@ EXERCISES = [
      "expect": "measured",
      "lesson": "build/release/fem_lessons batched-elements --chapter 12_NAME"},
     {"id": "14/1", "chapter": "14", "name": "ex_rowpairs",
-     "change": [("lane_v_cycle.hpp", "using InCacheLanes = LaneFineLevel;", "using InCacheLanes = RowPairFineLevel;"),
+     "change": [("lane_v_cycle.hpp", "using PaddedLanes = LaneFineLevel;", "using PaddedLanes = RowPairFineLevel;"),
                 ("lane_v_cycle.hpp", "#include \"chapters/14_every_lane/fine_smoothing.hpp\"\n",
                  "#include \"chapters/14_every_lane/fine_smoothing.hpp\"\n"
                  "#include \"chapters/14_every_lane/row_pairs.hpp\"\n"),
