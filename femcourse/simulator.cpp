@@ -214,8 +214,10 @@ struct Body::Impl {
   Eigen::Vector3d floor_point = Eigen::Vector3d::Zero(), floor_normal = Eigen::Vector3d::UnitZ();
   double floor_friction = 0.0;
   std::vector<int> contacts;
-  std::vector<int> stuck;   // the contacts friction holds still, sorted
-  std::vector<char> owned;  // per node: has a constraint of its own
+  std::vector<int> stuck;
+  std::vector<fem::NodeConstraint> composed;  // compose_constraints' storage, reused   // the
+                                              // contacts friction holds still, sorted
+  std::vector<char> owned;                    // per node: has a constraint of its own
   std::vector<std::array<int, 3>> surface;
   // The forces' model, made on first need (reactions, the floor, elastic_forces), and its
   // forces at the positions of one state: a force pass each time the positions change, shared
@@ -248,8 +250,8 @@ struct Body::Impl {
   bool is_grabbed(int node) const {
     return std::find(grabbed.begin(), grabbed.end(), node) != grabbed.end();
   }
-  std::vector<fem::NodeConstraint> compose_constraints() const;
-  void apply_constraints(std::vector<fem::NodeConstraint> constraints);
+  const std::vector<fem::NodeConstraint>& compose_constraints();
+  void apply_constraints(const std::vector<fem::NodeConstraint>& constraints);
   // A new stepper from the scene: no history (warm starts, rotations, a lagged hierarchy), so
   // that a saved state alone decides what follows.
   void restart_stepper() { rebuild_stepper(); }
@@ -281,8 +283,11 @@ struct Body::Impl {
   }
 };
 
-std::vector<fem::NodeConstraint> Body::Impl::compose_constraints() const {
-  std::vector<fem::NodeConstraint> all;
+// Into `composed`, whose storage is kept: a drag (move_grabbed) or a contact that sticks
+// allocates nothing once it has held as many constraints.
+const std::vector<fem::NodeConstraint>& Body::Impl::compose_constraints() {
+  std::vector<fem::NodeConstraint>& all = composed;
+  all.clear();
   for (const fem::NodeConstraint& c : own)
     if (!is_grabbed(c.node)) all.push_back(c);
   for (const int node : grabbed) all.push_back(fem::NodeConstraint::fixed(node, grab_velocity));
@@ -292,19 +297,21 @@ std::vector<fem::NodeConstraint> Body::Impl::compose_constraints() const {
   return all;
 }
 
-// In place when the stepper can; else a new stepper from the scene (the slow path). Either
-// way a throw leaves the scene's constraints and the stepper as they were.
-void Body::Impl::apply_constraints(std::vector<fem::NodeConstraint> constraints) {
+// In place when the stepper can (the scene's copy assigned into its own storage); else a new
+// stepper from the scene (the slow path). Either way a throw leaves the scene's constraints
+// and the stepper as they were.
+void Body::Impl::apply_constraints(const std::vector<fem::NodeConstraint>& constraints) {
   if (stepper->can_change_constraints()) {
     stepper->set_constraints(constraints);
-    scene.constraints = std::move(constraints);
+    scene.constraints.assign(constraints.begin(), constraints.end());
     return;
   }
-  std::swap(scene.constraints, constraints);
+  std::vector<fem::NodeConstraint> previous = constraints;
+  std::swap(scene.constraints, previous);
   try {
     rebuild_stepper();
   } catch (...) {
-    std::swap(scene.constraints, constraints);
+    std::swap(scene.constraints, previous);
     throw;
   }
 }
@@ -596,9 +603,20 @@ void Body::grab(const std::vector<int>& nodes, const std::array<double, 3>& velo
   }
 }
 
+// The same nodes at another velocity: no new list of nodes, the constraints composed into
+// their kept storage, so that a drag allocates nothing per frame (chapters that change their
+// constraints in place).
 void Body::move_grabbed(const std::array<double, 3>& velocity) {
   Impl& b = impl();
-  grab(std::vector<int>(b.grabbed), velocity);
+  if (!vector_of(velocity).allFinite()) refuse("move_grabbed: the velocity is not finite");
+  const Eigen::Vector3d previous = b.grab_velocity;
+  b.grab_velocity = vector_of(velocity);
+  try {
+    b.apply_constraints(b.compose_constraints());
+  } catch (...) {
+    b.grab_velocity = previous;
+    throw;
+  }
 }
 
 void Body::release() { grab({}); }

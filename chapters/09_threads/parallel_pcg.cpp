@@ -58,10 +58,15 @@ void ParallelPcg::set_constraints(const std::vector<NodeConstraint>& constraints
 void constraints_by_part(const std::vector<NodeConstraint>& constraints,
                          const std::vector<int>& start, std::vector<NodeConstraint>& sorted,
                          std::vector<int>& first) {
-  sorted = constraints;  // a copy: no reference into a scene
-  std::stable_sort(
-      sorted.begin(), sorted.end(),
-      [](const NodeConstraint& a, const NodeConstraint& b) { return a.node < b.node; });
+  // A copy (no reference into a scene) into `sorted`'s own storage, sorted by node. Not
+  // std::stable_sort: its temporary buffer is an allocation a call, and an app that drags a
+  // node changes the constraints every frame. std::sort keeps no order among equal keys, so
+  // the key is the node and then the kind: a node's constraints (a node named twice) are
+  // projections, applied in an order that does not depend on where they came in the list.
+  sorted.assign(constraints.begin(), constraints.end());
+  std::sort(sorted.begin(), sorted.end(), [](const NodeConstraint& a, const NodeConstraint& b) {
+    return a.node != b.node ? a.node < b.node : a.kind < b.kind;
+  });
   const int parts = static_cast<int>(start.size()) - 1;
   first.assign(parts + 1, 0);
   for (int p = 0, k = 0; p < parts; ++p) {

@@ -273,3 +273,32 @@ TEST_CASE(
   d.substeps = 0;
   CHECK_THROWS_WITH(Body(d), fem::test::contains_text("substeps is 0: 1 to 1000"));
 }
+
+TEST_CASE("a drag allocates nothing per frame once sized: move_grabbed, then a step", "[library]") {
+  Body body(clamped_beam());  // the default chapter changes its constraints in place
+  REQUIRE(body.changes_constraints_in_place());
+  std::vector<int> tip;
+  for (int i = 0; i < body.num_nodes(); ++i)
+    if (body.position(i)[0] > 0.99) tip.push_back(i);
+  REQUIRE_FALSE(tip.empty());
+  body.grab(tip, {0.0, 0.0, 0.1});
+  for (int k = 0; k < 3; ++k) {  // sizes every store a frame uses
+    body.move_grabbed({0.0, 0.01 * k, 0.1});
+    body.step();
+  }
+  long long moving = 0, stepping = 0;
+  for (int k = 0; k < 10; ++k) {
+    {
+      const fem::alloc::Scope scope;
+      body.move_grabbed({0.0, 0.02 * k, -0.1});
+      moving += scope.allocations();
+    }
+    const fem::alloc::Scope scope;
+    body.step();
+    stepping += scope.allocations();
+  }
+  CHECK(moving == 0);
+  CHECK(stepping == 0);
+  CHECK(body.grabbed() == tip);
+  CHECK_THROWS_AS(body.move_grabbed({0.0, std::nan(""), 0.0}), std::invalid_argument);
+}
