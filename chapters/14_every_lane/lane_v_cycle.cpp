@@ -27,10 +27,12 @@ void fill(Lanes& fine) {
 
 // The wall time of `sweeps` smoothing steps over the level's rows on this team, after one
 // untimed to bring its data to where the V-cycle finds them; step 1 from x, as the V-cycle
-// runs most. Every thread returns the time thread 0 took from barrier to barrier. The level's
-// direction and y are overwritten (the V-cycle's first step writes both afresh).
+// runs most. Every thread returns the time one thread took from barrier to barrier, through
+// `seconds`, which the team shares (a member of the cycle: two bodies' teams may time at
+// once). The level's direction and y are overwritten (the V-cycle's first step writes both
+// afresh).
 template <class Lanes>
-double smoothing_seconds(Lanes& fine, int sweeps) {
+double smoothing_seconds(Lanes& fine, int sweeps, double& seconds) {
   auto& v = fine.vectors;
   const int step = std::min(1, ch10::smoothing_steps(fine) - 1);
   const auto sweep = [&] {
@@ -39,7 +41,6 @@ double smoothing_seconds(Lanes& fine, int sweeps) {
     });
   };
   sweep();
-  static double seconds;  // shared by the team: written by one thread, read after a barrier
   const auto start = std::chrono::steady_clock::now();
   for (int k = 0; k < sweeps; ++k) sweep();
   ch09::on_one_thread(true, [&] {
@@ -75,7 +76,8 @@ std::optional<Layout> LaneVCycle::measured(int threads) const {
 Layout LaneVCycle::time_layouts() {
   fill(padded_);
   fill(packed_);
-  const double padded = smoothing_seconds(padded_, 3), packed = smoothing_seconds(packed_, 3);
+  const double padded = smoothing_seconds(padded_, 3, timed_seconds_);
+  const double packed = smoothing_seconds(packed_, 3, timed_seconds_);
   return packed < padded ? Layout::packed : Layout::padded;
 }
 

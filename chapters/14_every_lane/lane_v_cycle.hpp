@@ -72,6 +72,7 @@ class LaneVCycle {
   std::optional<Layout> forced_;
   std::array<signed char, kTeams + 1> measured_;  // per team size: -1, or the faster Layout
   Layout current_;
+  double timed_seconds_ = 0.0;  // time_layouts' timing, shared by the team
   PaddedLanes padded_;
   PackedLanes packed_;
   Eigen::VectorXf r_, s_;  // the PCG's residual and its preconditioned residual in float
