@@ -101,6 +101,14 @@ std::optional<double> parse_double(const std::string& s) {
 
 const std::string& ArgParser::get(const std::string& name) const { return options_.at(name).value; }
 
+const std::string& ArgParser::get_nonempty(const std::string& name) const {
+  const Option& o = options_.at(name);
+  if (o.set && o.value.empty())
+    throw UsageError("--" + name + ": an empty value names no " + o.value_name +
+                     ": give one, or leave the option out");
+  return o.value;
+}
+
 double ArgParser::get_double(const std::string& name) const {
   const std::optional<double> v = parse_double(get(name));
   if (v && std::isfinite(*v)) return *v;
