@@ -207,6 +207,12 @@ def bench_options(r):
           "refuse", r"--steps")
     r.run("lessons: phase-owners --check ''",
           [str(r.build / "fem_lessons"), "phase-owners", "--check", ""], "refuse", r"--check: an empty value")
+    # Each refused before any measurement: a lesson run for nothing, or every lesson recorded
+    # into a folder that could not be made, is what an empty value gave before.
+    for args, option in [(["spmv", "--json", ""], "json"), (["spmv", "--readme", ""], "readme"),
+                         (["record-all", "--out", ""], "out")]:
+        r.run(f"lessons: {args[0]} --{option} ''", [str(r.build / "fem_lessons"), *args],
+              "refuse", f"--{option}: an empty value")
     r.run("lessons: phase-owners --write ''",
           [str(r.build / "fem_lessons"), "phase-owners", "--write", ""], "refuse",
           r"--write: an empty value")
