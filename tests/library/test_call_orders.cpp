@@ -4,6 +4,7 @@
 // Each case says what a user expects: the documented result, bit for bit where the contract
 // promises it, and never a NaN passed off as a plausible state.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -295,4 +296,75 @@ TEST_CASE("call orders: the floor's friction survives a chapter switch and a sav
   CHECK_FALSE(none.floor);
   CHECK(none.floor_contacts.empty());
   CHECK(none.floor_stuck.empty());
+}
+
+TEST_CASE("call orders: a floor contact grabbed, saved and restored at once", "[library]") {
+  BodyDescription d = beam();
+  d.constraints.clear();
+  Body body(d);
+  double lowest = 1e300;
+  for (int i = 0; i < body.num_nodes(); ++i) lowest = std::min(lowest, body.position(i)[2]);
+  body.set_floor({0.0, 0.0, lowest - 0.01}, {0.0, 0.0, 1.0}, 0.8);
+  for (int k = 0; k < 20; ++k) body.step();
+  REQUIRE_FALSE(body.floor_contacts().empty());
+  const int contact = body.floor_contacts().front();
+  body.grab({contact}, {0.0, 0.0, 0.5});
+  const femcourse::BodyState saved = body.save_state();
+  CHECK(std::find(saved.floor_contacts.begin(), saved.floor_contacts.end(), contact) ==
+        saved.floor_contacts.end());
+  CHECK(std::find(saved.floor_stuck.begin(), saved.floor_stuck.end(), contact) ==
+        saved.floor_stuck.end());
+  CHECK_NOTHROW(body.restore_state(saved));  // what the body saved it takes back
+  body.step();
+  CHECK(body.position(contact)[2] > lowest - 0.01);
+  body.release();
+  for (int k = 0; k < 5; ++k) body.step();
+  CHECK(all_finite(positions_of(body)));
+}
+
+TEST_CASE("call orders: a body's own fixed node grabbed, put on a floor, released", "[library]") {
+  Body body(beam());
+  const int fixed = beam().constraints.front().node;
+  const std::array<double, 3> rest = body.position(fixed);
+  body.grab({fixed}, {0.0, 0.0, -1.0});
+  body.set_floor({0.0, 0.0, rest[2] - 0.02}, {0.0, 0.0, 1.0});
+  for (int k = 0; k < 4; ++k) body.step();
+  body.release();
+  const std::array<double, 3> held = body.position(fixed);
+  for (int k = 0; k < 4; ++k) body.step();
+  CHECK(body.position(fixed) == held);  // its own constraint back: it stays where it was let go
+  const std::vector<int>& contacts = body.floor_contacts();
+  CHECK(std::find(contacts.begin(), contacts.end(), fixed) == contacts.end());
+}
+
+TEST_CASE("call orders: a thread count, then a single-threaded chapter, then back", "[library]") {
+  Body body(beam());
+  body.set_threads(2);
+  body.set_chapter("01");
+  body.step();
+  CHECK(body.threads_used() == 1);
+  CHECK(body.threads() == 2);
+  body.set_chapter("");
+  body.step();
+  CHECK(body.threads_used() == 2);
+}
+
+TEST_CASE("call orders: a state with a floor restored, then the floor removed", "[library]") {
+  BodyDescription d = beam();
+  d.constraints.clear();
+  Body body(d);
+  double lowest = 1e300;
+  for (int i = 0; i < body.num_nodes(); ++i) lowest = std::min(lowest, body.position(i)[2]);
+  body.set_floor({0.0, 0.0, lowest - 0.01}, {0.0, 0.0, 1.0}, 0.3);
+  for (int k = 0; k < 20; ++k) body.step();
+  const femcourse::BodyState saved = body.save_state();
+  REQUIRE_FALSE(saved.floor_contacts.empty());
+  Body other(d);  // never had a floor
+  other.restore_state(saved);
+  CHECK(other.floor_contacts() == saved.floor_contacts);
+  other.remove_floor();
+  CHECK(other.floor_contacts().empty());
+  const double z = other.position(saved.floor_contacts.front())[2];
+  for (int k = 0; k < 10; ++k) other.step();
+  CHECK(other.position(saved.floor_contacts.front())[2] < z - 0.01);  // falls through: no floor
 }
