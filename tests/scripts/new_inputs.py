@@ -299,9 +299,14 @@ def meshes(r):
 
 def environment(r):
     beam = str(BEAM)
-    for value, expect, pattern in [(" 2", "ok", ""), ("+2", "ok", ""), ("02", "ok", ""),
-                                   ("9" * 20, "ok", ""), ("1.5", "ok", ""), ("２", "ok", ""),
-                                   ("2abc", "ok", ""), ("1,1,1", "ok", ""),
+    # A value libgomp reads whole is a count asked for; one it refuses (warning, then running its
+    # default) is none, or its default would pass for the user's count.
+    asked2, not_asked = r"threads: 2 \(asked", r"threads: not asked"
+    for value, expect, pattern in [(" 2", "ok", asked2), ("+2", "ok", asked2),
+                                   ("02", "ok", asked2), (" 2 ", "ok", asked2),
+                                   ("9" * 20, "ok", not_asked), ("1.5", "ok", not_asked),
+                                   ("２", "ok", not_asked), ("2abc", "ok", not_asked),
+                                   ("2,", "ok", not_asked), ("1,1,1", "ok", r"threads: 1 \(asked"),
                                    ("100000", "refuse", r"OMP_NUM_THREADS=100000")]:
         r.run(f"env: OMP_NUM_THREADS={value!r}", r.sim("--mesh", beam), expect, pattern,
               env={"OMP_NUM_THREADS": value})
