@@ -358,7 +358,9 @@ void announce_long_run(const std::string& program, double seconds_per_step, long
             << std::endl;
 }
 
-int run_program(const std::string& program, const std::function<int()>& body) {
+namespace {
+
+int run_body(const std::string& program, const std::function<int()>& body) {
   try {
     return body();
   } catch (const UsageError& e) {
@@ -368,6 +370,21 @@ int run_program(const std::string& program, const std::function<int()>& body) {
     std::cerr << program << ": error: " << e.what() << "\n";
     return 1;
   }
+}
+
+}  // namespace
+
+int run_program(const std::string& program, const std::function<int()>& body) {
+  const int status = run_body(program, body);
+  // What a program prints may be its result (fem_sim --watch, a lesson's table): lost to a full
+  // disk or a closed stream, it is a failure a script must see, not an exit status of 0.
+  if (!(std::cout << std::flush)) {
+    std::cerr << program
+              << ": error: cannot write the standard output (a full disk, or a "
+                 "closed stream): what the run printed is lost\n";
+    return status != 0 ? status : 1;
+  }
+  return status;
 }
 
 }  // namespace fem

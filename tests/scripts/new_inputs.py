@@ -71,13 +71,18 @@ class Runner:
         self.work = Path(tempfile.mkdtemp(prefix="fem_new_inputs_"))
         self.results = []  # (name, passed, detail)
 
-    def run(self, name, argv, expect, pattern="", env=None, timeout=120, stdin=None):
+    def run(self, name, argv, expect, pattern="", env=None, timeout=120, stdout=None):
+        """stdout: a file to write the standard output to ("/dev/full"), or "closed"."""
         full_env = dict(os.environ)
         full_env.pop("OMP_NUM_THREADS", None)
         full_env.update(env or {})
+        out_file = None if stdout in (None, "closed") else open(stdout, "w")
+        closing = (lambda: os.close(1)) if stdout == "closed" else None
         try:
-            p = subprocess.run(argv, cwd=self.work, env=full_env, capture_output=True,
-                               timeout=timeout, input=stdin)
+            p = subprocess.run(argv, cwd=self.work, env=full_env, timeout=timeout,
+                               stdout=out_file or subprocess.PIPE, stderr=subprocess.PIPE,
+                               preexec_fn=closing)
+            p.stdout = p.stdout or b""
         except subprocess.TimeoutExpired:
             self.results.append((name, False, f"hung (no end within {timeout} s)"))
             return
@@ -324,9 +329,26 @@ def environment(r):
           r.sim("--mesh", beam, "--E", "1e5"), "ok", r"515 nodes", env={"LC_ALL": "de_DE.UTF-8"})
 
 
+def standard_output(r):
+    # The printed result (a watched node, a table, the help) lost to a full disk or a closed
+    # stream: the exit status says so, as a shell pipeline's next command needs.
+    beam = str(BEAM)
+    lessons = str(r.build / "fem_lessons")
+    for target in ("/dev/full", "closed"):
+        r.run(f"stdout {target}: fem_sim --watch", r.sim("--mesh", beam, "--watch", "3"),
+              "refuse", r"cannot write the standard output", stdout=target)
+        r.run(f"stdout {target}: fem_sim --help", [str(r.build / "fem_sim"), "--help"],
+              "refuse", r"cannot write the standard output", stdout=target)
+        r.run(f"stdout {target}: fem_lessons phase-owners", [lessons, "phase-owners"],
+              "refuse", r"cannot write the standard output", stdout=target)
+    r.run("stdout /dev/full: a refused option keeps its own status 2",
+          r.sim("--mesh", beam, "--E", "0"), "refuse", r"E must be positive", stdout="/dev/full")
+
+
 def main():
     r = Runner(sys.argv[1])
-    for group in (sim_options, viewer_options, bench_options, meshes, environment):
+    for group in (sim_options, viewer_options, bench_options, meshes, environment,
+                  standard_output):
         group(r)
     failed = [(n, d) for n, ok, d in r.results if not ok]
     for name, detail in failed:
