@@ -270,10 +270,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string first = argv[1];
-  if (first == "--help" || first == "-h") {
-    std::cout << usage() << "(fem_lessons LESSON --help for the options)\n";
-    return 0;
-  }
+  if (first == "--help" || first == "-h")
+    return fem::run_program("fem_lessons", [] {
+      std::cout << usage() << "(fem_lessons LESSON --help for the options)\n";
+      return 0;
+    });
   if (first == "record-all") return record_all(lessons, argc - 1, argv + 1);
   if (first == "phase-owners") return phase_owners_command(argc - 1, argv + 1);
   const auto it = std::find_if(lessons.begin(), lessons.end(),

@@ -284,6 +284,20 @@ def meshes(r):
     sim_mesh("UTF-16 with a BOM", msh22().encode("utf-16"), "refuse", r"byte-order|MeshFormat")
     sim_mesh("CRLF everywhere", msh22().replace("\n", "\r\n"), "ok", r"6 tets")
     sim_mesh("no newline at the end", msh22().rstrip("\n"), "ok", r"6 tets")
+    # Read right, as the count and the numbers are there (gmsh's fscanf takes hexadecimal too).
+    sim_mesh("a node count with trailing text", msh22().replace("$Nodes\n8\n", "$Nodes\n8 junk\n"),
+             "ok", r"8 nodes, 6 tets")
+    sim_mesh("an element naming a node tag past the last", msh22(element_lines=[
+        "1 4 2 1 1 1 2 4 99"]), "refuse", r"99")
+    sim_mesh("a node tag of 2^31", msh22(first_tag=2 ** 31), "ok", r"8 nodes, 6 tets")
+    sim_mesh("exponent-only coordinates (1e0)", msh22(node_lines=[
+        f"{i + 1} {p[0]}e0 {p[1]}e0 {p[2]}e0" for i, p in enumerate(CORNERS)]), "ok", r"6 tets")
+    sim_mesh("hexadecimal coordinates", msh22(node_lines=[
+        f"{i + 1} 0x{p[0]}p0 0x{p[1]}p0 0x{p[2]}p0" for i, p in enumerate(CORNERS)]), "ok",
+        r"8 nodes, 6 tets")
+    sim_mesh("a NaN spelled nan(0x1)", msh22(node_lines=[
+        f"{i + 1} {'nan(0x1)' if i == 3 else p[0]} {p[1]} {p[2]}" for i, p in enumerate(CORNERS)]),
+        "refuse", r"NaN|node|line")
     sim_mesh("4.1 cube (control)", msh41(), "ok", r"8 nodes, 6 tets")
     sim_mesh("4.1 node block declaring 1e9 nodes", msh41(node_block_count=10 ** 9), "refuse",
              r"a node block of 1000000000 nodes where the header's 8 leave 8")
@@ -341,6 +355,9 @@ def standard_output(r):
               "refuse", r"cannot write the standard output", stdout=target)
         r.run(f"stdout {target}: fem_lessons phase-owners", [lessons, "phase-owners"],
               "refuse", r"cannot write the standard output", stdout=target)
+    for program in ("fem_bench", "fem_viewer", "fem_lessons"):
+        r.run(f"stdout /dev/full: {program} --help", [str(r.build / program), "--help"],
+              "refuse", r"cannot write the standard output", stdout="/dev/full")
     r.run("stdout /dev/full: a refused option keeps its own status 2",
           r.sim("--mesh", beam, "--E", "0"), "refuse", r"E must be positive", stdout="/dev/full")
 
