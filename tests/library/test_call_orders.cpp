@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "femcourse/simulator.hpp"
@@ -367,4 +368,31 @@ TEST_CASE("call orders: a state with a floor restored, then the floor removed", 
   const double z = other.position(saved.floor_contacts.front())[2];
   for (int k = 0; k < 10; ++k) other.step();
   CHECK(other.position(saved.floor_contacts.front())[2] < z - 0.01);  // falls through: no floor
+}
+
+TEST_CASE("call orders: a chapter switch and a thread count between save and restore",
+          "[library]") {
+  Body body(beam());
+  for (int k = 0; k < 4; ++k) body.step();
+  const femcourse::BodyState saved = body.save_state();
+  for (int k = 0; k < 4; ++k) body.step();
+  const std::vector<double> after = positions_of(body);
+  body.set_chapter("01");
+  for (int k = 0; k < 2; ++k) body.step();
+  body.set_chapter("");
+  body.set_threads(2);
+  body.restore_state(saved);  // the saved state alone decides every step, on any thread count
+  for (int k = 0; k < 4; ++k) body.step();
+  CHECK(positions_of(body) == after);
+  CHECK(body.time() == Approx(0.08));
+}
+
+TEST_CASE("call orders: take_warnings twice, the second empty", "[library]") {
+  BodyDescription d = beam();
+  d.solver_max_iterations = 1;  // a capped solve: a warning
+  Body body(d);
+  body.step();
+  const std::vector<std::string> first = body.take_warnings();
+  CHECK_FALSE(first.empty());
+  CHECK(body.take_warnings().empty());
 }
