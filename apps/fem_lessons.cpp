@@ -182,8 +182,8 @@ int run_lesson(const Found& found, int argc, char** argv) {
     const int steps = args.get_int("steps");
     if (steps <= 0) throw UsageError("--steps must be positive");
     const std::vector<std::pair<const ChapterInfo*, Lesson>> runs = lesson_runs(found, args);
-    const std::string& readme = args.get("readme");
-    const std::string& json = args.get("json");
+    const std::string& readme = args.get_nonempty("readme");
+    const std::string& json = args.get_nonempty("json");
     if ((!readme.empty() || !json.empty()) && runs.size() > 1)
       throw UsageError("--readme and --json record the course's table: leave --chapter out");
     if (!json.empty()) check_json_writable(json);
@@ -242,7 +242,7 @@ int record_all(const std::vector<Found>& lessons, int argc, char** argv) {
   args.option("out", "DIR", "directory of the records (made if missing)", "docs/data/lessons");
   return run_program(program, [&] {
     if (!args.parse(argc, argv)) return 0;
-    const std::string dir = args.get("out");
+    const std::string dir = args.get_nonempty("out");
     std::filesystem::create_directories(dir);
     for (const Found& found : lessons) {
       std::vector<std::string> words = recording_args(found.lesson, dir);
@@ -270,10 +270,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string first = argv[1];
-  if (first == "--help" || first == "-h") {
-    std::cout << usage() << "(fem_lessons LESSON --help for the options)\n";
-    return 0;
-  }
+  if (first == "--help" || first == "-h")
+    return fem::run_program("fem_lessons", [] {
+      std::cout << usage() << "(fem_lessons LESSON --help for the options)\n";
+      return 0;
+    });
   if (first == "record-all") return record_all(lessons, argc - 1, argv + 1);
   if (first == "phase-owners") return phase_owners_command(argc - 1, argv + 1);
   const auto it = std::find_if(lessons.begin(), lessons.end(),

@@ -228,17 +228,13 @@ int main(int argc, char** argv) {
   fem::ArgParser args("fem_sim",
                       "Simulates a scene with one chapter's stepper and writes VTK frames.");
   add_options(args);
-  try {
-    if (!args.parse(argc, argv)) return 0;
-    run_scene(args, run_from_args(args));
-  } catch (const fem::UsageError& e) {
-    std::cerr << "fem_sim: " << e.what() << " (see fem_sim --help)\n";
-    return 2;
-  } catch (const Stopped&) {
-    return 130;
-  } catch (const std::exception& e) {
-    std::cerr << "fem_sim: error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return fem::run_program("fem_sim", [&] {
+    try {
+      if (!args.parse(argc, argv)) return 0;
+      run_scene(args, run_from_args(args));
+    } catch (const Stopped&) {
+      return 130;
+    }
+    return 0;
+  });
 }

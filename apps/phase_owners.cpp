@@ -65,7 +65,7 @@ int phase_owners_command(int argc, char** argv) {
   args.option("check", "FILE", "exit 1 if FILE's table is not this one", "");
   return run_program(program, [&] {
     if (!args.parse(argc, argv)) return 0;
-    const std::string write = args.get("write"), check = args.get("check");
+    const std::string write = args.get_nonempty("write"), check = args.get_nonempty("check");
     if (!write.empty()) {
       write_between_markers(write, kMarkers, phase_owners_table());
       std::cout << "wrote the phase-owners table of " << write << "\n";

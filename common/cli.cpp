@@ -101,6 +101,14 @@ std::optional<double> parse_double(const std::string& s) {
 
 const std::string& ArgParser::get(const std::string& name) const { return options_.at(name).value; }
 
+const std::string& ArgParser::get_nonempty(const std::string& name) const {
+  const Option& o = options_.at(name);
+  if (o.set && o.value.empty())
+    throw UsageError("--" + name + ": an empty value names no " + o.value_name +
+                     ": give one, or leave the option out");
+  return o.value;
+}
+
 double ArgParser::get_double(const std::string& name) const {
   const std::optional<double> v = parse_double(get(name));
   if (v && std::isfinite(*v)) return *v;
@@ -350,7 +358,9 @@ void announce_long_run(const std::string& program, double seconds_per_step, long
             << std::endl;
 }
 
-int run_program(const std::string& program, const std::function<int()>& body) {
+namespace {
+
+int run_body(const std::string& program, const std::function<int()>& body) {
   try {
     return body();
   } catch (const UsageError& e) {
@@ -360,6 +370,21 @@ int run_program(const std::string& program, const std::function<int()>& body) {
     std::cerr << program << ": error: " << e.what() << "\n";
     return 1;
   }
+}
+
+}  // namespace
+
+int run_program(const std::string& program, const std::function<int()>& body) {
+  const int status = run_body(program, body);
+  // What a program prints may be its result (fem_sim --watch, a lesson's table): lost to a full
+  // disk or a closed stream, it is a failure a script must see, not an exit status of 0.
+  if (!(std::cout << std::flush)) {
+    std::cerr << program
+              << ": error: cannot write the standard output (a full disk, or a "
+                 "closed stream): what the run printed is lost\n";
+    return status != 0 ? status : 1;
+  }
+  return status;
 }
 
 }  // namespace fem

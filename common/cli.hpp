@@ -34,6 +34,9 @@ class ArgParser {
   bool parse(int argc, const char* const* argv);
 
   const std::string& get(const std::string& name) const;
+  // As get(), but an option given with an empty value ("--report $OUT", OUT unset) is refused
+  // rather than read as not given: a file or a drag the user asked for would silently vanish.
+  const std::string& get_nonempty(const std::string& name) const;
   double get_double(const std::string& name) const;  // throws UsageError if not a number
   int get_int(const std::string& name) const;        // throws UsageError if not an integer
   bool has_flag(const std::string& name) const;

@@ -1,6 +1,7 @@
 #include "common/threads.hpp"
 
 #include <Eigen/Core>
+#include <cctype>
 #include <cstdlib>
 #include <stdexcept>
 #include <thread>
@@ -78,12 +79,30 @@ std::string check_thread_count(int n) {
   return "";
 }
 
+namespace {
+
+// The value as libgomp reads it: positive integers separated by commas, blanks allowed. A value
+// it cannot read whole ("1.5", "2abc", "2,") it ignores, warning, and runs its default count,
+// which must not then pass for a count the user asked for.
+bool whole_thread_list(const char* s) {
+  for (;;) {
+    char* end = nullptr;
+    const long n = std::strtol(s, &end, 10);
+    if (end == s || n < 1) return false;
+    while (std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (*end == '\0') return true;
+    if (*end != ',') return false;
+    s = end + 1;
+  }
+}
+
+}  // namespace
+
 int thread_environment_count() {
   const char* value = std::getenv("OMP_NUM_THREADS");
-  if (!value) return 0;
-  char* end = nullptr;
-  const long n = std::strtol(value, &end, 10);  // "4,2" (nested levels): the outer count
-  return end == value || n < 1 || n > 1 << 20 ? 0 : static_cast<int>(n);
+  if (!value || !whole_thread_list(value)) return 0;
+  const long n = std::strtol(value, nullptr, 10);  // "4,2" (nested levels): the outer count
+  return n > 1 << 20 ? 0 : static_cast<int>(n);
 }
 
 std::string check_thread_environment() {

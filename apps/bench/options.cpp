@@ -29,6 +29,8 @@ std::string new_run_folder() {
 
 // --json FILE, else DIR/bench.json of --out DIR; "" with --no-json or when both are empty.
 std::string json_path(const ArgParser& args) {
+  args.get_nonempty("json");
+  args.get_nonempty("out");
   if (args.has_flag("no-json")) {
     if (args.has_flag("json") && !args.get("json").empty())
       throw UsageError("--no-json and --json " + args.get("json") + " contradict each other");

@@ -378,14 +378,14 @@ Options viewer_options(const fem::ArgParser& args) {
   options.frames = args.get_int("frames");
   options.width = args.get_int("width");
   options.height = args.get_int("height");
-  options.screenshot = args.get("screenshot");
-  options.report = args.get("report");
+  options.screenshot = args.get_nonempty("screenshot");
+  options.report = args.get_nonempty("report");
   options.fixed_dt = args.has_flag("fixed-dt");
   options.paused = args.has_flag("paused");
   if (options.frames < 0) throw UsageError("--frames must be >= 0");
   if (options.width < 64 || options.height < 64 || options.width > 8192 || options.height > 8192)
     throw UsageError("--width and --height must be in [64, 8192]");
-  const bool scripted = !args.get("replay-drag").empty() || !options.screenshot.empty();
+  const bool scripted = !args.get_nonempty("replay-drag").empty() || !options.screenshot.empty();
   if (scripted && options.frames == 0)
     throw UsageError("--replay-drag and --screenshot need --frames N");
   // The files the run ends with, checked before the work (the window, the frames).
