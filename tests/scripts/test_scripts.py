@@ -13,7 +13,7 @@ import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = ROOT / "tests" / "fixtures" / "bench_fixture.json"
-from femtools.docs import layouts, markdown
+from femtools.docs import markdown
 from femtools.plots import bench as plot_results
 from femtools.plots import style as plot_style
 from femtools.results.common import chapter_dir, footer
@@ -56,22 +56,6 @@ def viewer_fixture(bench):
     runs = [report("paused", "07_block_sparse", 31.25, 0.0)]
     runs += [report(c["chapter"], c["chapter"], 5.5 + k, 100.0 / (k + 1)) for k, c in enumerate(bench["chapters"])]
     return {"schema_version": 1, "commit": "fixture", "frames": 100, "runs": runs}
-
-
-def check_layout_lines():
-    """Chapter 14's layout lines: per thread count the stepper's choice (the caption) beside the
-    layout faster in both of the lesson's kernels, a disagreement marked."""
-    head = ("| plate.msh (9 rows), finest level, float | threads | chapter 12, us | pair lanes, us | "
-            "speedup | packed pairs, us | speedup |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n")
-    rows = ("| smoothing step | 1 | 9 | 5 | x | 4 | x |\n| residual | 1 | 9 | 5 | x | 4 | x |\n"
-            "| smoothing step | 2 | 9 | 3 | x | 4 | x |\n| residual | 2 | 9 | 3 | x | 4 | x |\n")
-    caption = ("\nMedians of 3 timings. The stepper's V-cycle runs this level padded at 1 thread, "
-               "padded at 2 threads (the faster in its own timing); filling it takes 1 us.\n")
-    text = layouts.section({"table": head + rows + caption})
-    check("chapter 14's layout lines: the stepper's choice beside the lesson's, per thread count",
-          "at 1 thread the stepper chose padded, packed faster in the lesson (**not** the stepper's)"
-          in text and "at 2 threads the stepper chose padded, padded faster in the lesson." in text,
-          text)
 
 
 def main():
@@ -226,7 +210,6 @@ def main():
                   f"{r['frames_per_second']:.1f} | {markdown.ms(r['mean_step_ms'])} |"
                   in results_md for r in viewer["runs"][1:]), results_md[results_md.find("viewer-fps"):][:600])
         check("a viewer file without runs is caught", validate_viewer({"runs": []}) != [])
-        check_layout_lines()
         chapter = (root / "chapters" / "01_naive" / "README.md").read_text()
         check("chapter 01 table filled", markdown.ms(naive["median_ms"]["forces"]) in chapter)
         threaded = [c for c in bench["chapters"] if "@" in c["chapter"]]
