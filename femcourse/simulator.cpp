@@ -262,6 +262,7 @@ struct Body::Impl {
   Eigen::Vector3d reaction(int node) const;
   void sub_step();
   void update_floor();
+  bool land_free_nodes();
   bool release_pulled_contacts();
   bool apply_friction();
   void warn_if_impact_inverts();
@@ -376,48 +377,46 @@ bool Body::Impl::release_pulled_contacts() {
   return true;
 }
 
-// Coulomb friction on the contacts that stay (set_floor): a stuck contact whose tangential
-// reaction exceeds friction * R_n slides from the next step; a sliding one loses along the
-// floor what the push can take in a step, friction * R_n * dt / m, and sticks when that stops
-// it. True when a contact changed between the two. model_forces() must be current; each
-// node's reaction is taken before its velocity changes (reaction reads it).
+// Coulomb friction on the contacts that stay (set_floor), by the reaction each needs, which
+// reaction() reads from its velocity: a velocity change dv moves it by c dv, c = m (1/dt +
+// alpha). A stuck contact whose tangential reaction exceeds friction * R_n slides from the next
+// step. A sliding one sticks (its velocity along the floor taken away) where the reaction that
+// leaves stays inside the cone |R_t| <= friction * R_n; else it loses along the floor what the
+// cone allows in a step, friction * R_n / c. True when a contact changed between the two.
+// model_forces() must be current; each node's reaction is taken before its velocity changes.
 bool Body::Impl::apply_friction() {
   if (floor_friction == 0.0) return false;
   bool changed = false;
+  const auto tangential = [&](const Eigen::Vector3d& f) {
+    return f - floor_normal.dot(f) * floor_normal;
+  };
   for (const int node : contacts) {
     const Eigen::Vector3d r = reaction(node);
-    const double push = std::max(0.0, r.dot(floor_normal));
+    const double cone = floor_friction * std::max(0.0, r.dot(floor_normal));
     if (is_stuck(node)) {
-      if ((r - push * floor_normal).norm() <= floor_friction * push) continue;
+      if (tangential(r).norm() <= cone) continue;
       stuck.erase(std::lower_bound(stuck.begin(), stuck.end(), node));
       changed = true;
       continue;
     }
     auto v = state.v.segment<3>(3 * node);
-    const Eigen::Vector3d along = v - floor_normal.dot(v) * floor_normal;
+    const Eigen::Vector3d along = tangential(v);
     const double speed = along.norm(), mass = model->lumped_mass[3 * node];
-    const double loss = floor_friction * push * scene.dt / mass;
-    if (loss < speed) {
-      v -= (loss / speed) * along;
-      continue;
+    const double c = mass * (1.0 / scene.dt + scene.damping.alpha);
+    if (tangential(r - c * along).norm() <= cone) {
+      v -= along;
+      stuck.insert(std::upper_bound(stuck.begin(), stuck.end(), node), node);
+      changed = true;
+    } else if (speed > 0.0) {
+      v -= std::min(1.0, cone / (c * speed)) * along;
     }
-    v -= along;
-    stuck.insert(std::upper_bound(stuck.begin(), stuck.end(), node), node);
-    changed = true;
   }
   return changed;
 }
 
-// The floor's active set after a step: contacts whose floor pulls are let go, friction on the
-// others, free nodes below it put on it with their velocity into it removed.
-void Body::Impl::update_floor() {
-  if (!floor_on) return;
-  bool changed = false, landed = false;
-  if (!contacts.empty()) {
-    model_forces();
-    changed = release_pulled_contacts();
-    changed = apply_friction() || changed;
-  }
+// Free nodes below the floor put on it, their velocity into it removed; true when one was.
+bool Body::Impl::land_free_nodes() {
+  bool landed = false;
   for (int node = 0; node < scene.mesh.num_nodes(); ++node) {
     const auto n = static_cast<std::size_t>(node);
     auto x = state.x.segment<3>(3 * node);
@@ -430,7 +429,24 @@ void Body::Impl::update_floor() {
     auto v = state.v.segment<3>(3 * node);
     v -= std::min(0.0, floor_normal.dot(v)) * floor_normal;
     contacts.push_back(node);
-    changed = landed = true;
+    landed = true;
+  }
+  return landed;
+}
+
+// The floor's active set after a step: free nodes below it put on it first, then, at the
+// positions that leaves, contacts whose floor pulls are let go and friction on the others.
+// In that order the reactions the floor decides by are those reactions() reports (one force
+// pass for both), and a node that lands meets friction in its landing step (the impact's
+// push limits its slide, as an impulse would).
+void Body::Impl::update_floor() {
+  if (!floor_on) return;
+  const bool landed = land_free_nodes();
+  bool changed = landed;
+  if (!contacts.empty()) {
+    model_forces();
+    changed = release_pulled_contacts() || changed;
+    changed = apply_friction() || changed;
   }
   if (changed) apply_constraints(compose_constraints());
   if (landed) warn_if_impact_inverts();

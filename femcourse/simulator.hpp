@@ -193,11 +193,12 @@ class Body {
   // next step finds them against the new plane. Throws std::invalid_argument for a zero or
   // non-finite normal, or a negative or non-finite friction.
   //
-  // Coulomb friction with coefficient `friction` (0: frictionless, a released body glides on):
-  // a sliding contact's velocity along the floor loses, after each step, what the floor's push
-  // R_n can take in one, friction * R_n * dt / m, and sticks when that stops it; a stuck
-  // contact is held still (its reaction has a tangential part R_t) and slides again once
-  // |R_t| > friction * R_n. The kinetic and the static coefficient are the same.
+  // Coulomb friction with coefficient `friction` (0: frictionless, a released body glides on),
+  // after each step, by the reactions (reactions()): a sliding contact sticks, its velocity
+  // along the floor taken away, where the reaction that leaves it stays inside the cone
+  // |R_t| <= friction * R_n, else loses along the floor what the cone allows in one step; a
+  // stuck contact is held still and slides again once |R_t| > friction * R_n. One coefficient,
+  // kinetic and static.
   void set_floor(const std::array<double, 3>& point, const std::array<double, 3>& normal,
                  double friction = 0.0);
   void remove_floor();
