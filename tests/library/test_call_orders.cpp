@@ -23,6 +23,20 @@ using femcourse::NodeForce;
 
 BodyDescription beam() { return fem::test::clamped_beam_description(); }
 
+// The beam, free, on a floor 1 cm under its lowest node with `friction`, after 20 steps; its
+// floor's height in `floor`.
+Body landed_beam(double friction, double& floor) {
+  BodyDescription d = beam();
+  d.constraints.clear();
+  Body body(d);
+  double lowest = 1e300;
+  for (int i = 0; i < body.num_nodes(); ++i) lowest = std::min(lowest, body.position(i)[2]);
+  floor = lowest - 0.01;
+  body.set_floor({0.0, 0.0, floor}, {0.0, 0.0, 1.0}, friction);
+  for (int k = 0; k < 20; ++k) body.step();
+  return body;
+}
+
 std::vector<double> positions_of(const Body& body) {
   return {body.positions(), body.positions() + 3 * body.num_nodes()};
 }
@@ -300,13 +314,8 @@ TEST_CASE("call orders: the floor's friction survives a chapter switch and a sav
 }
 
 TEST_CASE("call orders: a floor contact grabbed, saved and restored at once", "[library]") {
-  BodyDescription d = beam();
-  d.constraints.clear();
-  Body body(d);
-  double lowest = 1e300;
-  for (int i = 0; i < body.num_nodes(); ++i) lowest = std::min(lowest, body.position(i)[2]);
-  body.set_floor({0.0, 0.0, lowest - 0.01}, {0.0, 0.0, 1.0}, 0.8);
-  for (int k = 0; k < 20; ++k) body.step();
+  double floor = 0.0;
+  Body body = landed_beam(0.8, floor);
   REQUIRE_FALSE(body.floor_contacts().empty());
   const int contact = body.floor_contacts().front();
   body.grab({contact}, {0.0, 0.0, 0.5});
@@ -317,7 +326,7 @@ TEST_CASE("call orders: a floor contact grabbed, saved and restored at once", "[
         saved.floor_stuck.end());
   CHECK_NOTHROW(body.restore_state(saved));  // what the body saved it takes back
   body.step();
-  CHECK(body.position(contact)[2] > lowest - 0.01);
+  CHECK(body.position(contact)[2] > floor);
   body.release();
   for (int k = 0; k < 5; ++k) body.step();
   CHECK(all_finite(positions_of(body)));
@@ -351,15 +360,12 @@ TEST_CASE("call orders: a thread count, then a single-threaded chapter, then bac
 }
 
 TEST_CASE("call orders: a state with a floor restored, then the floor removed", "[library]") {
-  BodyDescription d = beam();
-  d.constraints.clear();
-  Body body(d);
-  double lowest = 1e300;
-  for (int i = 0; i < body.num_nodes(); ++i) lowest = std::min(lowest, body.position(i)[2]);
-  body.set_floor({0.0, 0.0, lowest - 0.01}, {0.0, 0.0, 1.0}, 0.3);
-  for (int k = 0; k < 20; ++k) body.step();
+  double floor = 0.0;
+  Body body = landed_beam(0.3, floor);
   const femcourse::BodyState saved = body.save_state();
   REQUIRE_FALSE(saved.floor_contacts.empty());
+  BodyDescription d = beam();
+  d.constraints.clear();
   Body other(d);  // never had a floor
   other.restore_state(saved);
   CHECK(other.floor_contacts() == saved.floor_contacts);
