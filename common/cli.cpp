@@ -360,8 +360,20 @@ void announce_long_run(const std::string& program, double seconds_per_step, long
 
 namespace {
 
+// OMP_NUM_THREADS's form is checked first, by every program, --threads given or not: the OpenMP
+// runtime reads the variable at its first call whatever the program asks, and LLVM's aborts on
+// a value that is not a count (common/threads.hpp, thread_environment_count).
+void check_thread_environment_form() {
+  try {
+    thread_environment_count();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 int run_body(const std::string& program, const std::function<int()>& body) {
   try {
+    check_thread_environment_form();
     return body();
   } catch (const UsageError& e) {
     std::cerr << program << ": " << e.what() << " (see " << program << " --help)\n";

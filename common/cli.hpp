@@ -96,7 +96,8 @@ std::vector<int> thread_counts_from_args(const ArgParser& args, const std::strin
 
 // main()'s error handling, written once: returns body()'s exit status; a UsageError prints
 // "<program>: <why> (see <program> --help)" and returns 2, any other exception
-// "<program>: error: <why>" and returns 1.
+// "<program>: error: <why>" and returns 1. Before body(), OMP_NUM_THREADS's form is checked
+// (thread_environment_count): a value that is not a count is a UsageError before any OpenMP call.
 int run_program(const std::string& program, const std::function<int()>& body);
 
 // A relative mesh path is looked up from the working directory, then from the repository.

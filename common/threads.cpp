@@ -81,17 +81,26 @@ std::string check_thread_count(int n) {
 
 namespace {
 
-// The value as libgomp reads it: positive integers separated by commas, blanks allowed. A value
-// it cannot read whole ("1.5", "2abc", "2,") it ignores, warning, and runs its default count,
-// which must not then pass for a count the user asked for.
-bool whole_thread_list(const char* s) {
+constexpr long kMostThreadsRead = 1L << 20;
+
+// The first count of OMP_NUM_THREADS's value when the value is whole: positive whole numbers up
+// to kMostThreadsRead, digits only, separated by commas (nested levels), blanks around each;
+// else 0. Only this form do the two OpenMP runtimes read alike. Outside it they part ways: GCC's
+// libgomp ignores the value, warning, and runs its default count; LLVM's libomp aborts at its
+// first call (signal 6) on "", "+2", "1.5", "2abc" or 20 nines, takes "abc" for a garbage count
+// and "2000000" for two million threads (measured with Clang 14's libomp, Debian 12).
+int first_of_whole_list(const char* s) {
+  int first = 0;
   for (;;) {
+    while (std::isspace(static_cast<unsigned char>(*s))) ++s;
+    if (!std::isdigit(static_cast<unsigned char>(*s))) return 0;  // no sign, no empty item
     char* end = nullptr;
     const long n = std::strtol(s, &end, 10);
-    if (end == s || n < 1) return false;
+    if (n < 1 || n > kMostThreadsRead) return 0;
+    if (first == 0) first = static_cast<int>(n);
     while (std::isspace(static_cast<unsigned char>(*end))) ++end;
-    if (*end == '\0') return true;
-    if (*end != ',') return false;
+    if (*end == '\0') return first;
+    if (*end != ',') return 0;
     s = end + 1;
   }
 }
@@ -100,13 +109,21 @@ bool whole_thread_list(const char* s) {
 
 int thread_environment_count() {
   const char* value = std::getenv("OMP_NUM_THREADS");
-  if (!value || !whole_thread_list(value)) return 0;
-  const long n = std::strtol(value, nullptr, 10);  // "4,2" (nested levels): the outer count
-  return n > 1 << 20 ? 0 : static_cast<int>(n);
+  if (!value) return 0;
+  const int first = first_of_whole_list(value);
+  if (first == 0)
+    throw std::invalid_argument(
+        std::string("OMP_NUM_THREADS='") + value +
+        "' is not a thread count: OpenMP's runtimes read whole numbers from 1 to " +
+        std::to_string(kMostThreadsRead) +
+        " (several, separated by commas, for nested levels) and differ on anything else "
+        "(LLVM's aborts, GCC's ignores it); unset it, or set it to a count such as 2 "
+        "(--threads N sets the count, but the runtime still reads the variable)");
+  return first;
 }
 
 std::string check_thread_environment() {
-  const int n = thread_environment_count();
+  const int n = thread_environment_count();  // throws for a value that is not a count
   if (n == 0) return "";
   const std::string name = std::string("OMP_NUM_THREADS=") + std::getenv("OMP_NUM_THREADS");
   try {

@@ -39,10 +39,14 @@ std::string check_thread_count(int n);
 
 // The same check of the count the environment asks for (OMP_NUM_THREADS, its first number),
 // which every program without --threads runs on: throws std::invalid_argument naming the
-// variable above thread_limit(), returns the warning above the hardware threads, "" when the
-// variable is unset (or not a count, which OpenMP ignores too).
+// variable when it is not a count (thread_environment_count) or above thread_limit(), returns
+// the warning above the hardware threads, "" when the variable is unset.
 std::string check_thread_environment();
-// The count OMP_NUM_THREADS asks for (its first number), 0 when unset or not a count.
+// The count OMP_NUM_THREADS asks for (its first number), 0 when unset. Throws
+// std::invalid_argument when it is set but not positive whole numbers separated by commas
+// (blank, "+2", "1.5", "2abc", past 2^20): the one form both OpenMP runtimes read alike (LLVM's
+// libomp aborts on the others at its first call), so every program checks it before that call,
+// with or without --threads.
 int thread_environment_count();
 
 // Sets the thread count for a scope and restores the previous one: tests, benchmarks.

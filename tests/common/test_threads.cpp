@@ -149,3 +149,31 @@ TEST_CASE(
   CHECK(check_thread_environment().empty());
   if (previous) ::setenv("OMP_NUM_THREADS", kept.c_str(), 1);
 }
+
+TEST_CASE(
+    "OMP_NUM_THREADS outside the one form both OpenMP runtimes read is refused, with the value "
+    "named",
+    "[threads]") {
+  const char* previous = std::getenv("OMP_NUM_THREADS");
+  const std::string kept = previous ? previous : "";
+  // Each of these LLVM's libomp aborts on, or reads as a count nobody asked for.
+  for (const char* value : {"", " ", "+2", "-1", "0", "1.5", "2abc", "abc", "2 3", "2,", ",2",
+                            "99999999999999999999", "2000000", "\xef\xbc\x92"}) {
+    CAPTURE(value);
+    ::setenv("OMP_NUM_THREADS", value, 1);
+    CHECK_THROWS_WITH(thread_environment_count(),
+                      test::contains_text(std::string("OMP_NUM_THREADS='") + value + "'") &&
+                          test::contains_text("not a thread count"));
+    CHECK_THROWS_AS(check_thread_environment(), std::invalid_argument);
+  }
+  // ... and these both read as the same count.
+  for (const auto& [value, count] : std::vector<std::pair<const char*, int>>{
+           {"2", 2}, {" 2 ", 2}, {"02", 2}, {"1,1,1", 1}, {"3 , 1", 3}, {"1048576", 1 << 20}}) {
+    CAPTURE(value);
+    ::setenv("OMP_NUM_THREADS", value, 1);
+    CHECK(thread_environment_count() == count);
+  }
+  ::unsetenv("OMP_NUM_THREADS");
+  CHECK(thread_environment_count() == 0);
+  if (previous) ::setenv("OMP_NUM_THREADS", kept.c_str(), 1);
+}
