@@ -10,6 +10,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#if __has_include(<unistd.h>)
+#include <fcntl.h>
+#include <unistd.h>
+#endif
+
 #include "common/atomic_file.hpp"
 #include "common/build_info.hpp"
 #include "common/threads.hpp"
@@ -371,6 +376,23 @@ void check_thread_environment_form() {
   }
 }
 
+// A standard stream the caller closed (`fem_sim >&-`) is held by /dev/null opened read-only:
+// closed, its number is the lowest free one, so the first file the program opens (a frame's
+// temporary file) would take it and receive the printout. Read-only, every write to it still
+// fails as it did closed, and run_program says so.
+void hold_closed_standard_streams() {
+#if __has_include(<unistd.h>)
+  for (const int fd : {0, 1, 2}) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    const int held = ::open("/dev/null", O_RDONLY);  // the lowest free number: fd itself
+    if (held != -1 && held != fd) {
+      ::dup2(held, fd);
+      ::close(held);
+    }
+  }
+#endif
+}
+
 int run_body(const std::string& program, const std::function<int()>& body) {
   try {
     check_thread_environment_form();
@@ -387,6 +409,7 @@ int run_body(const std::string& program, const std::function<int()>& body) {
 }  // namespace
 
 int run_program(const std::string& program, const std::function<int()>& body) {
+  hold_closed_standard_streams();
   const int status = run_body(program, body);
   // What a program prints may be its result (fem_sim --watch, a lesson's table): lost to a full
   // disk or a closed stream, it is a failure a script must see, not an exit status of 0.

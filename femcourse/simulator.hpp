@@ -149,8 +149,10 @@ class Body {
   Body& operator=(Body&&) noexcept;
 
   // One step of time_step (in `substeps` sub-steps). Throws StepDiverged if a sub-step cannot be
-  // trusted; the state is then that of the failed sub-step (restore_state() goes back to a
-  // saved one). profile() is the last sub-step's.
+  // trusted; the state is then what the failed sub-step left: its non-finite positions or
+  // velocities, or, where the solve overflowed, finite positions the solve did not change (CG
+  // stops at once: common/stepper.hpp, divergence); restore_state() goes back to a saved one.
+  // profile() is the last sub-step's.
   void step();
   // Replaces the external forces (the mouse drag) from the next step on; {} removes them.
   // Throws std::invalid_argument for a missing node or a non-finite force.

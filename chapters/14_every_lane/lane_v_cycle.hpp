@@ -10,8 +10,9 @@
 // book's recordings found the padded pairs faster on one machine and the packed on another
 // for the same level, and the two orders swapped between one thread and two. The layouts
 // compute the same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the
-// stepper times a few smoothing steps in each at its first prepare on each team size and runs
-// the faster: the state does not depend on the choice, only the time.
+// stepper times them in turn (five rounds of two smoothing steps, the best round of each) at
+// its first prepare on each team size and runs the faster: the state does not depend on the
+// choice, only the time.
 #pragma once
 
 #include <Eigen/Core>

@@ -367,6 +367,13 @@ def standard_output(r):
               "refuse", r"cannot write the standard output", stdout="/dev/full")
     r.run("stdout /dev/full: a refused option keeps its own status 2",
           r.sim("--mesh", beam, "--E", "0"), "refuse", r"E must be positive", stdout="/dev/full")
+    # A closed standard output is not a free number for the program's files to take: fem_bench
+    # holds its run folder's lock file open while it prints its tables, and printed them into it
+    # (then deleted it, exit status 0: the tables lost, silently).
+    r.run("stdout closed: fem_bench printing while its run's lock file is open",
+          [str(r.build / "fem_bench"), "--mesh", beam, "--chapters", "01", "--steps", "2",
+           "--out", "bench_closed"], "refuse", r"cannot write the standard output",
+          stdout="closed")
 
 
 def main():
