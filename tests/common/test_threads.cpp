@@ -6,6 +6,8 @@
 #include <Eigen/Core>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
+#include <string>
 
 #include "chapters/06_custom_pcg/stepper.hpp"
 #include "common/threads.hpp"
@@ -39,6 +41,25 @@ class Probe final : public Stepper {
  private:
   bool threaded_;
   StepProfile profile_;
+};
+
+// OMP_NUM_THREADS as the test found it, put back when the test ends (however it ends).
+class KeptThreadEnvironment {
+ public:
+  KeptThreadEnvironment() {
+    if (const char* value = std::getenv("OMP_NUM_THREADS")) value_ = value;
+  }
+  ~KeptThreadEnvironment() {
+    if (value_)
+      ::setenv("OMP_NUM_THREADS", value_->c_str(), 1);
+    else
+      ::unsetenv("OMP_NUM_THREADS");
+  }
+  KeptThreadEnvironment(const KeptThreadEnvironment&) = delete;
+  KeptThreadEnvironment& operator=(const KeptThreadEnvironment&) = delete;
+
+ private:
+  std::optional<std::string> value_;
 };
 
 }  // namespace
@@ -132,8 +153,7 @@ TEST_CASE(
     "OMP_NUM_THREADS is checked as --threads is: refused above the limit, warned above "
     "the hardware threads",
     "[threads]") {
-  const char* previous = std::getenv("OMP_NUM_THREADS");
-  const std::string kept = previous ? previous : "";
+  const KeptThreadEnvironment kept;
   const auto set = [](int n) { ::setenv("OMP_NUM_THREADS", std::to_string(n).c_str(), 1); };
   set(thread_limit() + 1);
   CHECK_THROWS_WITH(check_thread_environment(),
@@ -147,15 +167,13 @@ TEST_CASE(
   CHECK(check_thread_environment().empty());
   ::unsetenv("OMP_NUM_THREADS");
   CHECK(check_thread_environment().empty());
-  if (previous) ::setenv("OMP_NUM_THREADS", kept.c_str(), 1);
 }
 
 TEST_CASE(
     "OMP_NUM_THREADS outside the one form both OpenMP runtimes read is refused, with the value "
     "named",
     "[threads]") {
-  const char* previous = std::getenv("OMP_NUM_THREADS");
-  const std::string kept = previous ? previous : "";
+  const KeptThreadEnvironment kept;
   // Each of these LLVM's libomp aborts on, or reads as a count nobody asked for.
   for (const char* value : {"", " ", "+2", "-1", "0", "1.5", "2abc", "abc", "2 3", "2,", ",2",
                             "99999999999999999999", "2000000", "\xef\xbc\x92"}) {
@@ -175,5 +193,4 @@ TEST_CASE(
   }
   ::unsetenv("OMP_NUM_THREADS");
   CHECK(thread_environment_count() == 0);
-  if (previous) ::setenv("OMP_NUM_THREADS", kept.c_str(), 1);
 }
