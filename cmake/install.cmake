@@ -6,9 +6,10 @@
 # SDK). The same names work after add_subdirectory (the aliases below).
 #
 # What the package holds, and what it passes to a consumer:
-#  - headers: femcourse/*.hpp only (the public API; each compiles alone, with the standard
+#  - headers: femcourse/simulator.hpp only (the public API; it compiles alone, with the standard
 #    library only: tests/library/installed_package.sh). The course's own headers (common/,
-#    chapters/) are the advanced API of a build inside the source tree (add_subdirectory).
+#    chapters/, and the library's own femcourse/node_forces.hpp) are the advanced API of a build
+#    inside the source tree (add_subdirectory).
 #  - archives: fem_simulator, fem_steppers (the chapters' steppers, no lesson, report or work
 #    code), fem_core (what a stepper needs: no JSON, command line, VTK nor lessons), fem_fallbacks.
 #  - usage requirements: the include directory, and the OpenMP runtime to link (libgomp with
@@ -58,8 +59,7 @@ message(STATUS "femcourse package: compiled for ${FEM_PACKAGE_MARCH}: ${FEM_PACK
 
 install(TARGETS ${FEM_LIBRARY_TARGETS} EXPORT femcourse-targets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-install(DIRECTORY femcourse DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.hpp")
+install(FILES femcourse/simulator.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/femcourse)
 install(EXPORT femcourse-targets NAMESPACE femcourse:: DESTINATION ${FEM_INSTALL_CMAKEDIR})
 set(FEM_PACKAGE_HAS_OPENMP ${OpenMP_CXX_FOUND})
 

@@ -14,6 +14,7 @@
 #include "common/scene.hpp"
 #include "common/stepper.hpp"
 #include "common/threads.hpp"
+#include "femcourse/node_forces.hpp"
 
 namespace femcourse {
 inline namespace FEMCOURSE_ABI {
@@ -143,7 +144,19 @@ void check_node(int node, int num_nodes, const char* what) {
            std::to_string(num_nodes) + " nodes)");
 }
 
+// OMP_NUM_THREADS in a form both OpenMP runtimes read alike, before the body's first OpenMP
+// call: LLVM's libomp aborts the process at its first call on "1.5", "" or "+2" (GCC's ignores
+// them), so an app's first step would end in SIGABRT where a program of the course refuses.
+void check_thread_environment() {
+  try {
+    fem::thread_environment_count();
+  } catch (const std::invalid_argument& e) {
+    refuse(e.what());
+  }
+}
+
 void check_threads(int threads) {
+  check_thread_environment();
   if (threads < 0) refuse("threads is " + std::to_string(threads) + ": 0 (automatic) or more");
   if (threads > 1 && !fem::openmp_enabled())
     refuse("threads is " + std::to_string(threads) + ", but the library has no OpenMP: 0 or 1");
@@ -219,14 +232,14 @@ struct Body::Impl {
                                               // contacts friction holds still, sorted
   std::vector<char> owned;                    // per node: has a constraint of its own
   std::vector<std::array<int, 3>> surface;
-  // The forces' model, made on first need (reactions, the floor, elastic_forces), and its
-  // forces at the positions of one state: a force pass each time the positions change, shared
-  // by every read-out of that state (the floor's release test, reactions, elastic_forces).
+  // The forces' model, made on first need (reactions, the floor, elastic_forces), and the
+  // forces at the positions of one state, node by node (femcourse/node_forces.hpp): each
+  // element computed once per state and shared by every read-out of it (the floor's release
+  // test and friction, reactions, elastic_forces).
   mutable std::unique_ptr<fem::Model> model;
-  mutable std::vector<Eigen::Matrix3d> rotations;
-  mutable Eigen::VectorXd f_model;
+  mutable std::unique_ptr<detail::NodeForces> node_forces;
   long long positions_version = 0;  // counts the changes of state.x
-  mutable long long f_model_version = -1;
+  mutable long long forces_version = -1;
   mutable std::vector<NodeForce> reactions_out;  // the read-outs' storage, reused
   mutable std::vector<double> elastic_out;
   mutable std::unique_ptr<fem::DeformationProbe> probe;
@@ -253,13 +266,17 @@ struct Body::Impl {
   const std::vector<fem::NodeConstraint>& compose_constraints();
   void apply_constraints(const std::vector<fem::NodeConstraint>& constraints);
   // A new stepper from the scene: no history (warm starts, rotations, a lagged hierarchy), so
-  // that a saved state alone decides what follows.
-  void restart_stepper() { rebuild_stepper(); }
+  // that a saved state alone decides what follows; the read-outs' rotations start over too.
+  void restart_stepper() {
+    rebuild_stepper();
+    if (node_forces) node_forces->restart();
+  }
   void rebuild_stepper();
   void replace_contacts(std::vector<int> next, std::vector<int> next_stuck = {});
   bool is_stuck(int node) const { return std::binary_search(stuck.begin(), stuck.end(), node); }
-  const Eigen::VectorXd& model_forces() const;  // elastic + gravity at state.x
-  Eigen::Vector3d reaction(int node) const;
+  detail::NodeForces& read_forces() const;  // elastic + gravity at state.x, node by node
+  // `decides`: the body's own floor reads it (NodeForces::at's advance).
+  Eigen::Vector3d reaction(int node, bool decides = false) const;
   void sub_step();
   void update_floor();
   bool land_free_nodes();
@@ -338,35 +355,34 @@ void Body::Impl::replace_contacts(std::vector<int> next, std::vector<int> next_s
   }
 }
 
-const Eigen::VectorXd& Body::Impl::model_forces() const {
+detail::NodeForces& Body::Impl::read_forces() const {
   if (!model) {
     model = std::make_unique<fem::Model>(scene);
-    rotations.resize(scene.mesh.tets.size());
-    f_model.resize(model->dofs);
+    node_forces = std::make_unique<detail::NodeForces>(*model, scene);
   }
-  if (f_model_version != positions_version) {
-    fem::compute_rotations_and_forces(*model, state.x, rotations, f_model);
-    f_model_version = positions_version;
+  if (forces_version != positions_version) {
+    node_forces->new_positions();
+    forces_version = positions_version;
   }
-  return f_model;
+  return *node_forces;
 }
 
 // m dv/dt - f(x) - f_ext + alpha m v: what the constraint added to the node's momentum.
-// model_forces() must be current.
-Eigen::Vector3d Body::Impl::reaction(int node) const {
+Eigen::Vector3d Body::Impl::reaction(int node, bool decides) const {
+  const Eigen::Vector3d f = read_forces().at(
+      node, state.x, decides ? detail::NodeForces::Reader::floor : detail::NodeForces::Reader::app);
   const Eigen::Index i = 3 * node;
   const Eigen::Vector3d m = model->lumped_mass.segment<3>(i);
   const Eigen::Vector3d v = state.v.segment<3>(i);
   const Eigen::Vector3d dv = v - previous_v.segment<3>(i);
   Eigen::Vector3d f_ext = Eigen::Vector3d::Zero();
   for (int r = 0; r < 3; ++r) f_ext[r] = stepper->external_forces().coeff(i + r);
-  return m.cwiseProduct(dv) / scene.dt - f_model.segment<3>(i) - f_ext +
-         scene.damping.alpha * m.cwiseProduct(v);
+  return m.cwiseProduct(dv) / scene.dt - f - f_ext + scene.damping.alpha * m.cwiseProduct(v);
 }
 
-// Contacts whose floor pulls are let go; true when one was. model_forces() must be current.
+// Contacts whose floor pulls are let go; true when one was.
 bool Body::Impl::release_pulled_contacts() {
-  const auto pulling = [&](int node) { return reaction(node).dot(floor_normal) < 0.0; };
+  const auto pulling = [&](int node) { return reaction(node, true).dot(floor_normal) < 0.0; };
   const auto end = std::remove_if(contacts.begin(), contacts.end(), pulling);
   if (end == contacts.end()) return false;
   contacts.erase(end, contacts.end());
@@ -383,7 +399,7 @@ bool Body::Impl::release_pulled_contacts() {
 // step. A sliding one sticks (its velocity along the floor taken away) where the reaction that
 // leaves stays inside the cone |R_t| <= friction * R_n; else it loses along the floor what the
 // cone allows in a step, friction * R_n / c. True when a contact changed between the two.
-// model_forces() must be current; each node's reaction is taken before its velocity changes.
+// Each node's reaction is taken before its velocity changes.
 bool Body::Impl::apply_friction() {
   if (floor_friction == 0.0) return false;
   bool changed = false;
@@ -391,7 +407,7 @@ bool Body::Impl::apply_friction() {
     return f - floor_normal.dot(f) * floor_normal;
   };
   for (const int node : contacts) {
-    const Eigen::Vector3d r = reaction(node);
+    const Eigen::Vector3d r = reaction(node, true);
     const double cone = floor_friction * std::max(0.0, r.dot(floor_normal));
     if (is_stuck(node)) {
       if (tangential(r).norm() <= cone) continue;
@@ -436,15 +452,16 @@ bool Body::Impl::land_free_nodes() {
 
 // The floor's active set after a step: free nodes below it put on it first, then, at the
 // positions that leaves, contacts whose floor pulls are let go and friction on the others.
-// In that order the reactions the floor decides by are those reactions() reports (one force
-// pass for both), and a node that lands meets friction in its landing step (the impact's
-// push limits its slide, as an impulse would).
+// In that order the reactions the floor decides by are those reactions() reports (each
+// element's forces computed once for both), and a node that lands meets friction in its landing
+// step (the impact's push limits its slide, as an impulse would).
 void Body::Impl::update_floor() {
   if (!floor_on) return;
   const bool landed = land_free_nodes();
   bool changed = landed;
   if (!contacts.empty()) {
-    model_forces();
+    read_forces().prepare(
+        contacts, [](int node) { return node; }, state.x, detail::NodeForces::Reader::floor);
     changed = release_pulled_contacts() || changed;
     changed = apply_friction() || changed;
   }
@@ -492,6 +509,7 @@ Body::Body(const BodyDescription& d, const StepperFactory& make_stepper) {
 }
 
 Body::Body(fem::Scene scene, const fem::SolverSettings& solver, const std::string& chapter) {
+  check_thread_environment();
   fem::validate(scene);
   const fem::ChapterInfo& info = chapter_of(chapter);
   impl_ = std::make_unique<Impl>(std::move(scene), info.make, solver, info.id);
@@ -670,7 +688,9 @@ const std::vector<std::array<int, 3>>& Body::surface() const { return impl().sur
 
 const std::vector<NodeForce>& Body::reactions() const {
   const Impl& b = impl();
-  b.model_forces();
+  b.read_forces().prepare(
+      b.scene.constraints, [](const fem::NodeConstraint& c) { return c.node; }, b.state.x,
+      detail::NodeForces::Reader::app);
   b.reactions_out.clear();  // keeps its capacity
   for (const fem::NodeConstraint& c : b.scene.constraints) {
     const Eigen::Vector3d r = b.reaction(c.node);
@@ -681,7 +701,8 @@ const std::vector<NodeForce>& Body::reactions() const {
 
 const std::vector<double>& Body::elastic_forces() const {
   const Impl& b = impl();
-  const Eigen::VectorXd& forces = b.model_forces();  // makes the model: before its gravity
+  const Eigen::VectorXd& forces =
+      b.read_forces().all(b.state.x);  // makes the model: before gravity
   b.elastic_out.resize(static_cast<std::size_t>(forces.size()));
   Eigen::Map<Eigen::VectorXd>(b.elastic_out.data(), forces.size()) =
       forces - b.model->gravity_force;

@@ -141,7 +141,8 @@ class Body {
  public:
   // Throws std::invalid_argument naming the first bad element or node: an index out of range,
   // a zero-volume or inverted tetrahedron, a NaN, a node in no tetrahedron, a constraint on a
-  // missing node, a bad material or time step, an unknown chapter, a bad thread count.
+  // missing node, a bad material or time step, an unknown chapter, a bad thread count, or an
+  // OMP_NUM_THREADS that is not a count (LLVM's OpenMP runtime would abort the first step).
   explicit Body(const BodyDescription& description);
   ~Body();
   // A moved-from body throws std::logic_error from every call until one is assigned to it.
@@ -214,9 +215,12 @@ class Body {
   // The forces that the constraints (own, grabbed, floor) exerted on their nodes in the last
   // step [N]: m dv/dt minus the elastic, gravity, external and mass-damping forces at the new
   // state (the stiffness damping left out). Summed over a support at rest, minus the loads.
-  // The read-outs below are callable in any order. They share one force pass per state (the
-  // floor's contacts make it anyway after a step), and their storage is the body's, reused:
-  // no allocation once it has held as many values; valid until the body changes.
+  // The read-outs below are callable in any order, and reading them never changes a later
+  // step. Each element's forces are computed once per state and shared: reactions() costs the
+  // elements of the constrained nodes (those of the floor's contacts the floor computed
+  // already), elastic_forces() the others (docs/library.md, frame times, has their price).
+  // Their storage is the body's, reused: no allocation once it has held as many values; valid
+  // until the body changes.
   const std::vector<NodeForce>& reactions() const;
   // The elastic forces on every node at the current positions [N], 3 * num_nodes() values.
   const std::vector<double>& elastic_forces() const;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/lesson.hpp"
 #include "common/scene.hpp"
 #include "common/stepper.hpp"
 #include "common/threads.hpp"
@@ -119,6 +120,126 @@ std::string frame_times_table(const LessonRun& run) {
   return out.str();
 }
 
+// ---- the read-outs' price (docs/library.md, "Forces out") -------------------------------
+
+double median(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  return quantile(ms, 0.5);
+}
+
+template <class F>
+double elapsed_ms(F&& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// The scene without its supports, on a frictionless floor through its lowest rest node: it
+// lands and rests on the floor's contacts.
+Scene free_body(const Scene& scene) {
+  Scene free = scene;
+  free.constraints.clear();
+  free.external_forces.clear();
+  return free;
+}
+
+struct ReadoutTimes {
+  double step = 0.0, reactions = 0.0, elastic_first = 0.0, elastic_after = 0.0;
+  double resting = 0.0, held = 0.0;  // a step: on the floor, and held on the same nodes
+  std::size_t contacts = 0;
+};
+
+// After every step of the scene (its supports): reactions() then elastic_forces() on even
+// steps, elastic_forces() alone on odd ones, each call timed alone.
+void time_readouts(const Scene& scene, int steps, ReadoutTimes& out) {
+  femcourse::Body body(scene, SolverSettings{}, "");
+  body.set_threads(1);
+  std::vector<double> step, reactions, elastic_first, elastic_after;
+  for (int k = -20; k < steps; ++k) {
+    const double s = elapsed_ms([&] { body.step(); });
+    double r = 0.0, e = 0.0;
+    if (k % 2 == 0) {
+      r = elapsed_ms([&] { body.reactions(); });
+      e = elapsed_ms([&] { body.elastic_forces(); });
+    } else {
+      e = elapsed_ms([&] { body.elastic_forces(); });
+    }
+    if (k < 0) continue;
+    step.push_back(s);
+    if (k % 2 == 0) {
+      reactions.push_back(r);
+      elastic_after.push_back(e);
+    } else {
+      elastic_first.push_back(e);
+    }
+  }
+  out.step = median(step);
+  out.reactions = median(reactions);
+  out.elastic_first = median(elastic_first);
+  out.elastic_after = median(elastic_after);
+}
+
+// The free body dropped on the floor until it rests (200 steps), then the same state stepped
+// on the floor and held by Plane constraints of its own on the floor's contacts, in
+// alternating blocks of 20 steps, each step timed.
+void time_resting(const Scene& scene, int steps, ReadoutTimes& out) {
+  const Scene free = free_body(scene);
+  femcourse::Body resting(free, SolverSettings{}, "");
+  resting.set_threads(1);
+  double lowest = free.mesh.X.row(2).minCoeff();
+  resting.set_floor({0.0, 0.0, lowest}, {0.0, 0.0, 1.0});
+  for (int k = 0; k < 200; ++k) resting.step();
+  Scene held_scene = free;
+  for (const int node : resting.floor_contacts())
+    held_scene.constraints.push_back(NodeConstraint::plane(node, Eigen::Vector3d::UnitZ()));
+  femcourse::Body held(held_scene, SolverSettings{}, "");
+  held.set_threads(1);
+  held.set_state(resting.state());
+  out.contacts = resting.floor_contacts().size();
+  std::vector<double> on_floor, on_constraints;
+  for (int block = 0; block < std::max(1, steps / 20); ++block)
+    for (auto* body : {&resting, &held})
+      for (int k = 0; k < 20; ++k)
+        (body == &resting ? on_floor : on_constraints).push_back(elapsed_ms([&] { body->step(); }));
+  out.resting = median(on_floor);
+  out.held = median(on_constraints);
+}
+
+std::string percent(double part, double whole) { return fixed(100.0 * part / whole, 1) + "%"; }
+
+std::string readouts_table(const LessonRun& run) {
+  progress("frame times: the read-outs' price, one thread");
+  ReadoutTimes t;
+  time_readouts(run.scene, run.steps, t);
+  time_resting(run.scene, run.steps, t);
+  std::ostringstream out;
+  out << "| " << mesh_name(run.scene) << ", one thread | median ms | of a step |\n"
+      << "| --- | ---: | ---: |\n"
+      << "| a step (held by the scene's supports) | " << fixed(t.step, 3) << " | 100% |\n"
+      << "| `reactions()` after it | " << fixed(t.reactions, 3) << " | "
+      << percent(t.reactions, t.step) << " |\n"
+      << "| `elastic_forces()` after `reactions()` | " << fixed(t.elastic_after, 3) << " | "
+      << percent(t.elastic_after, t.step) << " |\n"
+      << "| `elastic_forces()` alone | " << fixed(t.elastic_first, 3) << " | "
+      << percent(t.elastic_first, t.step) << " |\n"
+      << "| the body unsupported, resting on a floor (" << t.contacts << " contacts): a step | "
+      << fixed(t.resting, 3) << " | |\n"
+      << "| the same held by Plane constraints on those nodes: a step | " << fixed(t.held, 3)
+      << " | floor / held x" << fixed(t.resting / t.held, 2) << " |\n"
+      << "\nEach call timed alone (std::chrono::steady_clock) after 20 unmeasured steps, the "
+         "medians of "
+      << run.steps
+      << " steps; the resting and the held body from one state, in alternating "
+         "blocks of 20 steps. "
+      << measured_on() << ". Generated by `fem_lessons frame-times`.\n";
+  return out.str();
+}
+
+std::string tables(const LessonRun& run) {
+  return frame_times_table(run) + "\n" + readouts_table(run);
+}
+
 }  // namespace
 
 std::vector<Lesson> lessons() {
@@ -127,7 +248,7 @@ std::vector<Lesson> lessons() {
                 "longest, quiet and beside a busy core, plain and dragged",
                 "meshes/plate_poster.msh",
                 nullptr,
-                frame_times_table,
+                tables,
                 true};
   lesson.readme = "docs/library.md";
   lesson.record_args = {"--steps", "2000"};

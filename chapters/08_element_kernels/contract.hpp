@@ -14,7 +14,8 @@
 // |                |                                | multiply_rows(x, y, first, last)          |
 // | Preconditioner | (const PartSetup&, const Params&) | a PreconditionerPart: prepare(A),      |
 // |                |                                | apply(r, s) [, block_diagonal(),          |
-// |                |                                | apply_rows(first, last, r, s)]            |
+// |                |                                | apply_rows(first, last, r, s),            |
+// |                |                                | set_constraints(c)]                       |
 // | Solver         | (const PartSetup&, const Params&) | solve(system, product, preconditioner, |
 // |                |                                | settings), set_constraints(c)             |
 //
@@ -121,6 +122,10 @@ class PreconditionerPart {
   // inside its own loops, with no barrier (apply_rows, which such a part must override).
   virtual bool block_diagonal() const { return false; }
   virtual void apply_rows(int first, int last, const Eigen::VectorXd& r, Eigen::VectorXd& s) const;
+  // The constraints changed while the body runs (in the step's numbering), from the next
+  // prepare on. A part built only from each step's A needs nothing; one that keeps what it set
+  // up from the constraints (a multigrid's coarse space) sets it up again.
+  virtual void set_constraints(const std::vector<NodeConstraint>& constraints);
 };
 
 // The roles, in the order StepOf builds them: the one list that the phase owners, the walk over

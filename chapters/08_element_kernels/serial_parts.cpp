@@ -44,6 +44,8 @@ void PreconditionerPart::apply_rows(int, int, const Eigen::VectorXd&, Eigen::Vec
   assert(false && "apply_rows: only a block-diagonal preconditioner applies rows alone");
 }
 
+void PreconditionerPart::set_constraints(const std::vector<NodeConstraint>&) {}
+
 BlockJacobi::BlockJacobi(const PartSetup& setup, const Params&)
     : diagonal_block_(setup.system.index.diagonal), inverse_diagonal_(diagonal_block_.size()) {}
 

@@ -137,9 +137,8 @@ class StepOf<Recipe, true> final : public Stepper {
   }
 
   // Constraints change while the body runs (a grab, a release, a floor's contacts): the order
-  // renames them, the step's filter and the solver read them from the next step on. The
-  // preconditioner keeps what it was set up with (a multigrid's rigid-body modes): under the
-  // PCG's filter it stays a symmetric positive definite preconditioner, perhaps a weaker one.
+  // renames them, the step's filter, the preconditioner and the solver read them from the next
+  // step on (a multigrid sets its coarse space up again: PreconditionerPart::set_constraints).
   // Throws std::invalid_argument for a node out of range, and changes nothing then.
   bool can_change_constraints() const override { return true; }
   void set_constraints(const std::vector<NodeConstraint>& constraints) override {
@@ -147,6 +146,7 @@ class StepOf<Recipe, true> final : public Stepper {
       if (c.node < 0 || c.node >= model_.num_nodes)
         throw std::invalid_argument("set_constraints: no node " + std::to_string(c.node));
     order_.set_constraints(constraints);
+    preconditioner_.set_constraints(order_.scene().constraints);
     solver_.set_constraints(order_.scene().constraints);
   }
 

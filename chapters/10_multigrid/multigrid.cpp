@@ -96,6 +96,8 @@ void Multigrid::analyze_pattern(const std::vector<int>& row_start, const std::ve
   if (rest_positions.size() != 3 * fine_.nodes())
     throw std::invalid_argument("multigrid: rest positions do not match the pattern");
   set_up(fine_, settings_);
+  rest_positions_ = rest_positions;
+  modes_constraints_ = constraints;
   coarsening_ = std::make_unique<Coarsening>();
   Aggregates<3>& fine = coarsening_->fine;
 
@@ -156,12 +158,36 @@ void Multigrid::build_tentatives() {
     build(coarse_[l], c.coarse[l], coarse_[l + 1], c.coarse[l + 1]);
 }
 
-// The set-up data is dead once P is smoothed on the first matrix, unless P is smoothed again
-// at every refresh (then T stays).
+// Once P is smoothed, the set-up data goes but for what set_constraints needs to build it again
+// (each level's aggregates: the modes come from the rest positions, T from the modes), and T
+// where P is smoothed again at every refresh.
 void Multigrid::finish_set_up() {
-  if (!(settings_.coarsening.smooth_prolongator && settings_.coarsening.update_prolongator))
-    coarsening_.reset();
+  const bool keep_tentative =
+      settings_.coarsening.smooth_prolongator && settings_.coarsening.update_prolongator;
+  const auto release = [keep_tentative](auto& aggregates) {
+    Rows().swap(aggregates.graph);
+    decltype(aggregates.modes)().swap(aggregates.modes);
+    if (!keep_tentative) decltype(aggregates.tentative)().swap(aggregates.tentative);
+  };
+  release(coarsening_->fine);
+  for (auto& level : coarsening_->coarse) release(level);
   prolongators_ready_ = true;
+}
+
+void Multigrid::set_constraints(const std::vector<NodeConstraint>& constraints) {
+  const auto same = [](const NodeConstraint& a, const NodeConstraint& b) {
+    return a.node == b.node && a.filter == b.filter;
+  };
+  if (coarse_.empty() ||
+      (constraints.size() == modes_constraints_.size() &&
+       std::equal(constraints.begin(), constraints.end(), modes_constraints_.begin(), same)))
+    return;
+  modes_constraints_.assign(constraints.begin(), constraints.end());
+  Aggregates<3>& fine = coarsening_->fine;
+  fine.modes = rigid_body_modes(rest_positions_, constraints, fine.aggregate, coarse_[0].nodes(),
+                                settings_.coarsening.modes);
+  build_tentatives();
+  prolongators_ready_ = false;  // the next factorize: a refresh, the modes improved, P smoothed
 }
 
 // ---- every step: the numbers ------------------------------------------------------------------

@@ -83,6 +83,14 @@ class Multigrid {
   void analyze_pattern(const std::vector<int>& row_start, const std::vector<int>& column,
                        const Eigen::VectorXd& rest_positions,
                        const std::vector<NodeConstraint>& constraints);
+  // The constraints changed while the body runs: the modes filtered by the new ones, and the
+  // next factorize sets the prolongators up on its matrix as the first one did (a refresh).
+  // P smoothed on a matrix without these constraints keeps, in the coarse space, directions
+  // they took away: a plate landing flat on a floor (964 of its 2069 nodes held at once, one
+  // step after a free one) then took 350 iterations a solve in chapter 11 and never converged
+  // in chapters 12-14 (tests/chapters/ch10_multigrid.cpp). Only the constrained nodes and
+  // directions count: a drag, which changes their velocities, sets nothing up again.
+  void set_constraints(const std::vector<NodeConstraint>& constraints);
   // The numbers of this step's filtered matrix (same pattern as at set-up): the smoothers
   // of the finest level; at a refresh also the coarse matrices, their smoothers, the
   // Cholesky factor (and the prolongators the first time). The blocks must stay alive and
@@ -138,8 +146,10 @@ class Multigrid {
   MultigridSettings settings_;
   Level<3> fine_;
   std::vector<Level<kModes>> coarse_;
-  std::unique_ptr<Coarsening> coarsening_;  // until P is smoothed on the first matrix
+  std::unique_ptr<Coarsening> coarsening_;  // the aggregates kept: set_constraints builds P again
   bool prolongators_ready_ = false;
+  Eigen::VectorXd rest_positions_;                 // the modes' positions
+  std::vector<NodeConstraint> modes_constraints_;  // the constraints the modes were filtered by
   RefreshRule refresh_rule_;
 };
 

@@ -24,6 +24,9 @@ class MultigridPreconditioner final : public ch08::PreconditionerPart {
   MultigridPreconditioner(const ch08::PartSetup& setup, const Params& params);
   void prepare(const ch07::BlockSparseMatrix& A) override;
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override;
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    multigrid_.set_constraints(constraints);
+  }
   Multigrid& multigrid() { return multigrid_; }
   const Multigrid& multigrid() const { return multigrid_; }
   // The hierarchy it built: per level its rows, blocks and bytes.

@@ -55,6 +55,10 @@ class ReducedMultigrid final : public ch08::PreconditionerPart {
   // Chapter 10's factorize in double, then the new numbers into float; one cycle in Real.
   void prepare(const ch07::BlockSparseMatrix& A) override { reduced_.prepare(A); }
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override { reduced_.apply(r, s); }
+  // The hierarchy set up again; its next refresh converts the new prolongators into float.
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    hierarchy_.set_constraints(constraints);
+  }
   ReducedVCycle<Real>& v_cycle() { return reduced_; }
   ch10::Multigrid& multigrid() { return hierarchy_.multigrid(); }
   const ch10::Multigrid& multigrid() const { return hierarchy_.multigrid(); }

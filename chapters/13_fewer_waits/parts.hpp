@@ -29,6 +29,9 @@ class FusedPreconditioner final : public ch08::PreconditionerPart {
       : reduced_(setup, params), fused_(reduced_.v_cycle(), reduced_.multigrid()) {}
   void prepare(const ch07::BlockSparseMatrix& A) override { fused_.prepare(A); }
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override { fused_.apply(r, s); }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    reduced_.set_constraints(constraints);
+  }
   // Its cycle in two parts (enter, complete), which a solver may run inside loops of its own
   // (SingleReductionSolver asks for it at compile time).
   FusedVCycle& fused_cycle() { return fused_; }

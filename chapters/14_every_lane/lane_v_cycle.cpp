@@ -74,10 +74,12 @@ std::optional<Layout> LaneVCycle::measured(int threads) const {
 
 // The layouts timed in turn, kRounds rounds of kSweeps sweeps each, and each layout's best round
 // kept: a single timing of each (three sweeps, first) picked on beam_50k the layout the lesson's
-// whole solves found slower, one book the one way and the next the other, because a sweep there
-// takes a millisecond and a machine's hiccup is as long. Alternating spreads a drift of the
-// machine over both; the best round is the one least disturbed. On the plate the whole takes a
-// millisecond, on an 80,000-node beam about a tenth of one step, once per team size.
+// smoothing kernel found slower, because a sweep there takes a millisecond and a machine's hiccup
+// is as long. Alternating spreads a drift of the machine over both; the best round is the one
+// least disturbed. It has not settled the question: where the two are within a few percent (one
+// thread) the choice follows the noise, and at two threads the faster one swapped between
+// sittings (the README's measured effect). On the plate the whole takes a millisecond, on an
+// 80,000-node beam about a tenth of one step, once per team size.
 Layout LaneVCycle::time_layouts() {
   constexpr int kRounds = 5, kSweeps = 2;
   fill(padded_);

@@ -24,6 +24,9 @@ class LaneMultigrid final : public ch08::PreconditionerPart {
       : reduced_(setup, params), lanes_(reduced_.v_cycle(), reduced_.multigrid()) {}
   void prepare(const ch07::BlockSparseMatrix& A) override { lanes_.prepare(A); }
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) override { lanes_.apply(r, s); }
+  void set_constraints(const std::vector<NodeConstraint>& constraints) override {
+    reduced_.set_constraints(constraints);
+  }
   LaneVCycle& lane_v_cycle() { return lanes_; }
   const LaneVCycle& lane_v_cycle() const { return lanes_; }
   ch12::ReducedMultigrid<float>& reduced() { return reduced_; }
