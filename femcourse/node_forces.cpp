@@ -76,15 +76,33 @@ void NodeForces::compute_batch(const int* elements, int count, const Eigen::Vect
                                Reader reader) {
   std::array<std::vector<double>, 4>& starts = reader == Reader::floor ? floor_starts_ : starts_;
   Lanes ds[9], dm[9], start[4], q[4], mu, lambda;
+  const auto element = [&](int l) {
+    return static_cast<std::size_t>(elements[std::min(l, count - 1)]);
+  };
+  if (count == kLanes && elements[kLanes - 1] == elements[0] + kLanes - 1) {
+    // Eight consecutive elements (elastic_forces, a floor under a slab): vector loads.
+    const std::size_t e0 = element(0);
+    const auto load = [e0](const std::vector<double>& from, Lanes& to) {
+#pragma omp simd
+      for (int l = 0; l < kLanes; ++l) to.v[l] = from[e0 + static_cast<std::size_t>(l)];
+    };
+    for (std::size_t k = 0; k < 9; ++k) load(dm_[k], dm[k]);
+    for (std::size_t c = 0; c < 4; ++c) load(starts[c], start[c]);
+    load(mu_volume_, mu);
+    load(lambda_volume_, lambda);
+  } else {
+    for (int l = 0; l < kLanes; ++l) {
+      const std::size_t e = element(l);
+      for (std::size_t k = 0; k < 9; ++k) dm[k].v[l] = dm_[k][e];
+      for (std::size_t c = 0; c < 4; ++c) start[c].v[l] = starts[c][e];
+      mu.v[l] = mu_volume_[e];
+      lambda.v[l] = lambda_volume_[e];
+    }
+  }
   for (int l = 0; l < kLanes; ++l) {
-    const auto e = static_cast<std::size_t>(elements[std::min(l, count - 1)]);
-    const Eigen::Vector4i& t = model_.tets[e];
+    const Eigen::Vector4i& t = model_.tets[element(l)];
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) ds[3 * i + j].v[l] = x[3 * t[j + 1] + i] - x[3 * t[0] + i];
-    for (std::size_t k = 0; k < 9; ++k) dm[k].v[l] = dm_[k][e];
-    for (std::size_t c = 0; c < 4; ++c) start[c].v[l] = starts[c][e];
-    mu.v[l] = mu_volume_[e];
-    lambda.v[l] = lambda_volume_[e];
   }
   // `last` and `before` both the start: chapter 08's prediction R_k R_{k-1}^T R_k is then R_k.
   fem::ch12::polar_rotations(ds, dm, start, start, count, q, fallbacks_);
@@ -171,8 +189,13 @@ const Eigen::VectorXd& NodeForces::all(const Eigen::VectorXd& x) {
     staged_.push_back(static_cast<int>(e));
   }
   compute_staged(x, Reader::app);
-  for (std::size_t n = 0; n < node_stamps_.size(); ++n)
-    if (!node_stamps_[n].serves(version_, Reader::app)) sum_node(n, Reader::app);
+  // Every node's sum at once, in element order as sum_node adds (so to the same bits): a
+  // stream over the elements' forces instead of a gather of each node's.
+  f_ = model_.gravity_force;
+  for (std::size_t e = 0; e < forces_.size(); ++e)
+    for (int a = 0; a < 4; ++a) f_.segment<3>(3 * model_.tets[e][a]) += forces_[e].col(a);
+  for (Stamp& stamp : node_stamps_)
+    if (!stamp.serves(version_, Reader::app)) stamp = {version_, Reader::app};
   return f_;
 }
 
