@@ -69,8 +69,8 @@ class NodeForces {
   std::array<std::vector<double>, 4> floor_starts_, starts_;
   std::vector<Eigen::Matrix<double, 3, 4>> forces_;  // each element's, on its four corners
   std::vector<Stamp> element_stamps_, node_stamps_;
-  std::vector<int> first_,
-      corners_;              // node n's elements: 4 e + corner, in [first_[n], first_[n+1])
+  // Node n's elements, as 4 e + the node's corner in e, in corners_[first_[n] .. first_[n+1]).
+  std::vector<int> first_, corners_;
   std::vector<int> staged_;  // elements to compute, each once
   Eigen::VectorXd f_;
   long long version_ = 0;

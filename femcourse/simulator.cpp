@@ -275,7 +275,7 @@ struct Body::Impl {
   void replace_contacts(std::vector<int> next, std::vector<int> next_stuck = {});
   bool is_stuck(int node) const { return std::binary_search(stuck.begin(), stuck.end(), node); }
   detail::NodeForces& read_forces() const;  // elastic + gravity at state.x, node by node
-  // `decides`: the body's own floor reads it (NodeForces::at's advance).
+  // `decides`: the body's own floor decides by it (NodeForces::Reader::floor).
   Eigen::Vector3d reaction(int node, bool decides = false) const;
   void sub_step();
   void update_floor();
