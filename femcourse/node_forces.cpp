@@ -62,7 +62,8 @@ void NodeForces::stage_node(int node, Reader reader) {
 }
 
 void NodeForces::compute_staged(const Eigen::VectorXd& x, Reader reader) {
-  std::sort(staged_.begin(), staged_.end());  // along the arrays: each batch's numbers close
+  // Along the arrays, so that each batch's numbers lie close; all() stages in order already.
+  if (!std::is_sorted(staged_.begin(), staged_.end())) std::sort(staged_.begin(), staged_.end());
   const int count = static_cast<int>(staged_.size());
   for (int first = 0; first < count; first += kLanes)
     compute_batch(staged_.data() + first, std::min(kLanes, count - first), x, reader);
@@ -192,8 +193,13 @@ const Eigen::VectorXd& NodeForces::all(const Eigen::VectorXd& x) {
   // Every node's sum at once, in element order as sum_node adds (so to the same bits): a
   // stream over the elements' forces instead of a gather of each node's.
   f_ = model_.gravity_force;
-  for (std::size_t e = 0; e < forces_.size(); ++e)
-    for (int a = 0; a < 4; ++a) f_.segment<3>(3 * model_.tets[e][a]) += forces_[e].col(a);
+  double* const f = f_.data();
+  for (std::size_t e = 0; e < forces_.size(); ++e) {
+    const Eigen::Vector4i& t = model_.tets[e];
+    const double* const force = forces_[e].data();  // column-major: corner a at 3 a
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) f[3 * t[a] + i] += force[3 * a + i];
+  }
   for (Stamp& stamp : node_stamps_)
     if (!stamp.serves(version_, Reader::app)) stamp = {version_, Reader::app};
   return f_;

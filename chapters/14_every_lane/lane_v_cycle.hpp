@@ -7,12 +7,12 @@
 // Which layout is faster is a measurement, not a rule. Padded pairs (a pair's column one load,
 // 48 bytes a block) take fewer instructions; packed pairs (36 bytes a block, chapter 12's)
 // read fewer bytes. Which wins depends on the caches, the memory and the thread count: the
-// book's recordings found the padded pairs faster on one machine and the packed on another
-// for the same level, and the two orders swapped between one thread and two. The layouts
-// compute the same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the
-// stepper times them in turn (five rounds of two smoothing steps, the best round of each) at
-// its first prepare on each team size and runs the faster: the state does not depend on the
-// choice, only the time.
+// book's recordings found the padded faster on one machine and the packed on another for the
+// same level, and the two orders swapped between one thread and two. The layouts compute the
+// same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the stepper times
+// them where they run: its first V-cycles on each team size alternate the two (five each),
+// whole cycles as the PCG applies them, and it keeps the one of the shorter median. The
+// state does not depend on the choice, only the time.
 #pragma once
 
 #include <Eigen/Core>
@@ -41,17 +41,18 @@ class LaneVCycle {
              std::optional<Layout> forced = std::nullopt);
 
   // Chapter 12's prepare (chapter 10's factorize, its numbers into float), then the finest
-  // level's double blocks into the layout this team size runs (both, and the timing, the
-  // first time on it). By every thread.
+  // level's double blocks into the layout this team size runs (both, while its V-cycles time
+  // them). By every thread.
   void prepare(const ch07::BlockSparseMatrix& A);
-  // s = M r: one float V-cycle from the lanes' finest level. By every thread.
+  // s = M r: one float V-cycle from the lanes' finest level; one of the trial's, timed, until
+  // this team size has chosen. By every thread.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // A hierarchy of one level is its coarsest, solved by chapter 10's Cholesky factor: no lanes.
   bool lanes() const { return lanes_; }
   // The layout the last prepare filled, which apply runs.
   Layout layout() const { return current_; }
-  // The layout measured faster on a team of `threads`, if one has prepared.
+  // The layout measured faster on a team of `threads`, once its trial is over.
   std::optional<Layout> measured(int threads) const;
   // f(the finest level in the layout it runs).
   template <class F>
@@ -65,15 +66,26 @@ class LaneVCycle {
 
  private:
   static constexpr int kTeams = 64;  // team sizes remembered (a larger one shares the last)
-  Layout time_layouts();             // by every thread: the faster layout on this team
+  static constexpr int kTrials = 5;  // V-cycles timed in each layout
+  // One team size's trial: the seconds of each V-cycle, padded's then packed's.
+  struct Trial {
+    int applies = 0;
+    std::array<double, 2 * kTrials> seconds{};
+    Layout next() const;
+    void record(Layout layout, double time);
+    Layout faster();  // reorders `seconds`
+  };
+  void run(const Eigen::VectorXd& r, Eigen::VectorXd& s);  // s = M r in the current layout
 
   ch12::ReducedVCycle<float>& reduced_;
   ch10::Multigrid& multigrid_;
   bool lanes_;
   std::optional<Layout> forced_;
   std::array<signed char, kTeams + 1> measured_;  // per team size: -1, or the faster Layout
+  std::array<Trial, kTeams + 1> trials_;
   Layout current_;
-  double timed_seconds_ = 0.0;  // time_layouts' timing, shared by the team
+  bool both_filled_ = false;  // by the last prepare: a trial may run
+  double started_ = 0.0;      // the trial's V-cycle began, shared by the team
   PaddedLanes padded_;
   PackedLanes packed_;
   Eigen::VectorXf r_, s_;  // the PCG's residual and its preconditioned residual in float

@@ -66,21 +66,31 @@ std::function<void()> residual(Layouts& l, int layout) {
   };
 }
 
-// One whole V-cycle, chapter 12's and this chapter's (on the same hierarchy), as the PCG
-// applies them: a row per thread count.
+// One whole V-cycle, chapter 12's and this chapter's in each layout (on the same hierarchy),
+// as the PCG applies them: a row per thread count. The stepper chooses between the two by this
+// measure, in its first V-cycles on each team (LaneVCycle::apply).
 void v_cycle_rows(EveryLaneStepper& stepper, int threads_max, int repeat, std::ostream& out) {
   LaneMultigrid& part = stepper.preconditioner();
   ch12::ReducedVCycle<float>& reduced = part.reduced().v_cycle();
+  LaneVCycle padded(reduced, part.multigrid(), Layout::padded);
+  LaneVCycle packed(reduced, part.multigrid(), Layout::packed);
+  ch09::run_parallel([&] {
+    padded.prepare(stepper.system_matrix());
+    packed.prepare(stepper.system_matrix());
+  });
   const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(stepper.system_rhs().size(), -1.0, 1.0);
   Eigen::VectorXd s(r.size());
   for (int threads = 1; threads <= threads_max; ++threads) {
     const double old_us = us_per_call(
         threads, [&] { reduced.apply(r, s); }, repeat);
-    const double new_us = us_per_call(
-        threads, [&] { part.lane_v_cycle().apply(r, s); }, repeat);
+    const double padded_us = us_per_call(
+        threads, [&] { padded.apply(r, s); }, repeat);
+    const double packed_us = us_per_call(
+        threads, [&] { packed.apply(r, s); }, repeat);
     out << "| one V-cycle (" << ch10::smoother_products(part.multigrid()) << " fine products) | "
-        << threads << " | " << std::setprecision(1) << old_us << " | " << new_us << " | x"
-        << std::setprecision(2) << old_us / new_us << " | | | | | | |\n";
+        << threads << " | " << std::setprecision(1) << old_us << " | " << padded_us << " | x"
+        << std::setprecision(2) << old_us / padded_us << " | " << std::setprecision(1) << packed_us
+        << " | x" << std::setprecision(2) << old_us / packed_us << " | | | | |\n";
   }
 }
 
@@ -143,13 +153,19 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   EveryLaneStepper stepper(scene, {});
   State state = rest_state(scene);
   const int threads_max = std::min(2, max_threads());
-  // A step on each team size, so that the stepper has timed its layouts on each.
-  for (int k = 0; k < 3; ++k) {
+  LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
+  // Steps on each team size in turn (at least three), until the stepper has timed its layouts
+  // on each: ten V-cycles, more than one step's on a small mesh.
+  const auto chosen = [&] {
+    for (int n = 1; n <= threads_max; ++n)
+      if (!cycle.measured(n)) return false;
+    return true;
+  };
+  for (int k = 0; k < 3 || (cycle.lanes() && k < 40 && !chosen()); ++k) {
     const ThreadCountScope scope(1 + k % threads_max);
     const AskedThreadsScope asked(true);  // chapter 09's adaptive team keeps the count
     stepper.step(state);
   }
-  LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
   if (!cycle.lanes()) return "(" + mesh_name(scene) + ": one level, no finest level to fill)\n";
   FloatLevel& padded = stepper.preconditioner().reduced().v_cycle().fine_level();
   Layouts l{padded,
@@ -166,7 +182,8 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   v_cycle_rows(stepper, threads_max, repeat, out);
   out << "\nMedians of " << repeat << " timings. The stepper's V-cycle runs this level "
       << stepper_layouts(cycle, threads_max)
-      << " (the faster in its own timing at its first step on that team); filling it from the "
+      << " (the shorter median of its first ten V-cycles on that team, the layouts in turn); "
+         "filling it from the "
          "double blocks takes "
       << std::setprecision(1) << fill_us(cycle, l.part, repeat) << " us at 1 thread.\n";
   return out.str();
