@@ -54,12 +54,12 @@ std::optional<Layout> LaneVCycle::measured(int threads) const {
 // The trial's order: padded, packed, packed, padded, padded, packed, ... (each pair of turns
 // reversed), so that a drift of the machine's speed over the trial weighs on both alike.
 Layout LaneVCycle::Trial::next() const {
-  return ((applies + 1) / 2) % 2 == 0 ? Layout::padded : Layout::packed;
+  return ((steps + 1) / 2) % 2 == 0 ? Layout::padded : Layout::packed;
 }
 
-// The layout whose median V-cycle was the shorter: a median, not a mean, because one
-// V-cycle disturbed by the machine (or the first, with data still in the other layout's
-// place) would move a mean by more than the layouts differ.
+// The layout whose median step was the shorter: a median, not a mean, because one step
+// disturbed by the machine (or the first, with data still in the other layout's place) would
+// move a mean by more than the layouts differ.
 Layout LaneVCycle::Trial::faster() {
   const auto median = [](double* first) {
     std::nth_element(first, first + kTrials / 2, first + kTrials);
@@ -70,61 +70,49 @@ Layout LaneVCycle::Trial::faster() {
 }
 
 void LaneVCycle::Trial::record(Layout layout, double time) {
-  seconds[(layout == Layout::packed ? kTrials : 0) + applies / 2] = time;
-  ++applies;
+  seconds[(layout == Layout::packed ? kTrials : 0) + steps / 2] = time;
+  ++steps;
+}
+
+// By one thread, at the next prepare: the step's end is its last V-cycle's, since only then
+// is it known to be the last. A step whose solve ran no V-cycle (a guess already converged)
+// is not a trial's.
+void LaneVCycle::end_trial_step() {
+  if (trial_team_ == 0 || ended_ <= started_) return;
+  Trial& trial = trials_[trial_team_];
+  trial.record(current_, ended_ - started_);
+  if (trial.steps == 2 * kTrials) measured_[trial_team_] = static_cast<signed char>(trial.faster());
 }
 
 void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A) {
   reduced_.prepare(A);
   if (!lanes_) return;
   const int team = std::clamp(team_size(), 1, kTeams);
-  const bool trial = !forced_ && measured_[team] < 0;
-  ch09::on_one_thread(true, [&] { both_filled_ = trial; });
-  if (trial) {  // apply times the two in turn
-    fill(padded_);
-    fill(packed_);
-    return;
-  }
-  const Layout layout = forced_ ? *forced_ : Layout(measured_[team]);
-  ch09::on_one_thread(true, [&] { current_ = layout; });
-  if (layout == Layout::padded)
+  ch09::on_one_thread(true, [&] {
+    end_trial_step();
+    const bool trial = !forced_ && measured_[team] < 0;
+    trial_team_ = trial ? team : 0;
+    current_ = forced_ ? *forced_ : trial ? trials_[team].next() : Layout(measured_[team]);
+    started_ = ended_ = now_seconds();
+  });
+  if (current_ == Layout::padded)
     fill(padded_);
   else
     fill(packed_);
 }
 
-void LaneVCycle::run(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
-  const std::vector<int>& part = reduced_.fine_level().source->rows.part;
-  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(r, r_, first, last); });
-  with_fine_level([&](auto& fine) { multigrid_.apply(fine, reduced_.coarse_levels(), r_, s_); });
-  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(s_, s, first, last); });
-}
-
+// A V-cycle of a trial's step ends after every thread's share (the last convert_rows ends in
+// the team's barrier); one thread reads the clock.
 void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   if (!lanes_) {
     reduced_.apply(r, s);
     return;
   }
-  const int team = std::clamp(team_size(), 1, kTeams);
-  if (!both_filled_ || measured_[team] >= 0) {
-    run(r, s);
-    return;
-  }
-  // A V-cycle of the trial, timed from barrier to barrier by one thread (the team shares
-  // started_): the whole cycle, its coarse levels and conversions in the caches the layout
-  // leaves them, since that, not the smoothing step alone, is what the solve waits for.
-  Trial& trial = trials_[team];
-  ch09::on_one_thread(true, [&] {
-    current_ = trial.next();
-    started_ = now_seconds();
-  });
-  run(r, s);
-  ch09::on_one_thread(true, [&] {
-    trial.record(current_, now_seconds() - started_);
-    if (trial.applies < 2 * kTrials) return;
-    current_ = trial.faster();
-    measured_[team] = static_cast<signed char>(current_);
-  });
+  const std::vector<int>& part = reduced_.fine_level().source->rows.part;
+  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(r, r_, first, last); });
+  with_fine_level([&](auto& fine) { multigrid_.apply(fine, reduced_.coarse_levels(), r_, s_); });
+  ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(s_, s, first, last); });
+  if (trial_team_ != 0) ch09::on_one_thread(true, [&] { ended_ = now_seconds(); });
 }
 
 }  // namespace fem::ch14

@@ -10,9 +10,10 @@
 // book's recordings found the padded faster on one machine and the packed on another for the
 // same level, and the two orders swapped between one thread and two. The layouts compute the
 // same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the stepper times
-// them where they run: its first V-cycles on each team size alternate the two (five each),
-// whole cycles as the PCG applies them, and it keeps the one of the shorter median. The
-// state does not depend on the choice, only the time.
+// them where they run: its first ten steps on each team size alternate the two (five each),
+// each timed from its fill to its last V-cycle, so the PCG's product and updates between the
+// cycles count (they run in the caches the layout leaves them), and it keeps the one of the
+// shorter median. The state does not depend on the choice, only the time.
 #pragma once
 
 #include <Eigen/Core>
@@ -41,11 +42,10 @@ class LaneVCycle {
              std::optional<Layout> forced = std::nullopt);
 
   // Chapter 12's prepare (chapter 10's factorize, its numbers into float), then the finest
-  // level's double blocks into the layout this team size runs (both, while its V-cycles time
-  // them). By every thread.
+  // level's double blocks into the layout this team size runs (while it has not chosen: the
+  // trial's next, and the last step's trial time recorded). By every thread, once a step.
   void prepare(const ch07::BlockSparseMatrix& A);
-  // s = M r: one float V-cycle from the lanes' finest level; one of the trial's, timed, until
-  // this team size has chosen. By every thread.
+  // s = M r: one float V-cycle from the lanes' finest level. By every thread.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
 
   // A hierarchy of one level is its coarsest, solved by chapter 10's Cholesky factor: no lanes.
@@ -54,6 +54,9 @@ class LaneVCycle {
   Layout layout() const { return current_; }
   // The layout measured faster on a team of `threads`, once its trial is over.
   std::optional<Layout> measured(int threads) const;
+  // From the next prepare on, run `layout` on every team (std::nullopt: the measured one), as
+  // `forced` does; the lesson's whole steps in each layout. Between steps, not in a V-cycle.
+  void force(std::optional<Layout> layout) { forced_ = layout; }
   // f(the finest level in the layout it runs).
   template <class F>
   decltype(auto) with_fine_level(F&& f) {
@@ -66,16 +69,16 @@ class LaneVCycle {
 
  private:
   static constexpr int kTeams = 64;  // team sizes remembered (a larger one shares the last)
-  static constexpr int kTrials = 5;  // V-cycles timed in each layout
-  // One team size's trial: the seconds of each V-cycle, padded's then packed's.
+  static constexpr int kTrials = 5;  // steps timed in each layout
+  // One team size's trial: the seconds of each step's fill and solve, padded's then packed's.
   struct Trial {
-    int applies = 0;
+    int steps = 0;
     std::array<double, 2 * kTrials> seconds{};
     Layout next() const;
     void record(Layout layout, double time);
     Layout faster();  // reorders `seconds`
   };
-  void run(const Eigen::VectorXd& r, Eigen::VectorXd& s);  // s = M r in the current layout
+  void end_trial_step();  // the last step's time into its team's trial, once it has one
 
   ch12::ReducedVCycle<float>& reduced_;
   ch10::Multigrid& multigrid_;
@@ -84,8 +87,9 @@ class LaneVCycle {
   std::array<signed char, kTeams + 1> measured_;  // per team size: -1, or the faster Layout
   std::array<Trial, kTeams + 1> trials_;
   Layout current_;
-  bool both_filled_ = false;  // by the last prepare: a trial may run
-  double started_ = 0.0;      // the trial's V-cycle began, shared by the team
+  int trial_team_ = 0;    // the team size the last prepare's step is a trial of, or 0
+  double started_ = 0.0;  // that step's fill began, by one thread's clock
+  double ended_ = 0.0;    // its last V-cycle so far ended
   PaddedLanes padded_;
   PackedLanes packed_;
   Eigen::VectorXf r_, s_;  // the PCG's residual and its preconditioned residual in float

@@ -2,6 +2,8 @@
 #include "chapters/14_every_lane/lesson.hpp"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <functional>
 #include <iomanip>
 #include <optional>
@@ -13,6 +15,7 @@
 #include "chapters/10_multigrid/work.hpp"
 #include "chapters/14_every_lane/row_pairs.hpp"
 #include "chapters/14_every_lane/stepper.hpp"
+#include "common/statistics.hpp"
 #include "common/threads.hpp"
 
 namespace fem::ch14 {
@@ -66,31 +69,54 @@ std::function<void()> residual(Layouts& l, int layout) {
   };
 }
 
-// One whole V-cycle, chapter 12's and this chapter's in each layout (on the same hierarchy),
-// as the PCG applies them: a row per thread count. The stepper chooses between the two by this
-// measure, in its first V-cycles on each team (LaneVCycle::apply).
-void v_cycle_rows(EveryLaneStepper& stepper, int threads_max, int repeat, std::ostream& out) {
-  LaneMultigrid& part = stepper.preconditioner();
-  ch12::ReducedVCycle<float>& reduced = part.reduced().v_cycle();
-  LaneVCycle padded(reduced, part.multigrid(), Layout::padded);
-  LaneVCycle packed(reduced, part.multigrid(), Layout::packed);
-  ch09::run_parallel([&] {
-    padded.prepare(stepper.system_matrix());
-    packed.prepare(stepper.system_matrix());
-  });
-  const Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(stepper.system_rhs().size(), -1.0, 1.0);
-  Eigen::VectorXd s(r.size());
+// Microseconds of one step of `stepper`.
+double step_us(Stepper& stepper, State& state) {
+  const auto start = std::chrono::steady_clock::now();
+  stepper.step(state);
+  return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// Whole steps, what the layout's choice is for: chapter 12's stepper and this chapter's, the
+// latter in each layout in turn (LaneVCycle::force: the same object, the same arrays, and the
+// same bits in either layout), each from rest. A round: chapter 12's step, this chapter's in
+// the two layouts one after the other (padded first in even rounds, packed in odd, so that a
+// drift of the machine weighs on both alike), chapter 12's again; three rounds first untimed.
+// The two adjacent steps of a round are a pair: in how many rounds the packed was the shorter
+// says whether the medians' difference is the layouts' or the machine's (a sign test). A row
+// per thread count, microseconds a step.
+void step_rows(const Scene& scene, int threads_max, int rounds, std::ostream& out) {
+  ch12::HalfBytesStepper old(scene, {});
+  EveryLaneStepper lanes(scene, {});
+  LaneVCycle& cycle = lanes.preconditioner().lane_v_cycle();
+  State old_state = rest_state(scene), lanes_state = old_state;
   for (int threads = 1; threads <= threads_max; ++threads) {
-    const double old_us = us_per_call(
-        threads, [&] { reduced.apply(r, s); }, repeat);
-    const double padded_us = us_per_call(
-        threads, [&] { padded.apply(r, s); }, repeat);
-    const double packed_us = us_per_call(
-        threads, [&] { packed.apply(r, s); }, repeat);
-    out << "| one V-cycle (" << ch10::smoother_products(part.multigrid()) << " fine products) | "
-        << threads << " | " << std::setprecision(1) << old_us << " | " << padded_us << " | x"
-        << std::setprecision(2) << old_us / padded_us << " | " << std::setprecision(1) << packed_us
-        << " | x" << std::setprecision(2) << old_us / packed_us << " | | | | |\n";
+    const ThreadCountScope scope(threads);
+    const AskedThreadsScope asked(true);  // chapter 09's adaptive team keeps the count
+    std::vector<double> old_us, padded_us, packed_us;
+    int packed_shorter = 0;
+    for (int round = 0; round < 3 + rounds; ++round) {
+      progress(mesh_name(scene) + ": whole steps on " + std::to_string(threads) +
+               " thread(s), round " + std::to_string(round + 1) + " of " +
+               std::to_string(3 + rounds));
+      std::array<double, 4> us{step_us(old, old_state)};
+      for (const int k : {1, 2}) {
+        const bool padded = (k == 1) == (round % 2 == 0);
+        cycle.force(padded ? Layout::padded : Layout::packed);
+        us[padded ? 1 : 2] = step_us(lanes, lanes_state);
+      }
+      us[3] = step_us(old, old_state);
+      if (round < 3) continue;
+      old_us.insert(old_us.end(), {us[0], us[3]});
+      padded_us.push_back(us[1]);
+      packed_us.push_back(us[2]);
+      packed_shorter += us[2] < us[1];
+    }
+    out << "| one step (" << rounds << " rounds; packed shorter in " << packed_shorter << ") | "
+        << threads << " | " << std::setprecision(0) << median(old_us) << " | " << median(padded_us)
+        << " | x" << std::setprecision(2) << median(old_us) / median(padded_us) << " | "
+        << std::setprecision(0) << median(packed_us) << " | x" << std::setprecision(2)
+        << median(old_us) / median(packed_us) << " | | | | |\n";
   }
 }
 
@@ -155,13 +181,13 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   const int threads_max = std::min(2, max_threads());
   LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
   // Steps on each team size in turn (at least three), until the stepper has timed its layouts
-  // on each: ten V-cycles, more than one step's on a small mesh.
+  // on each: ten steps on each, chosen at the eleventh.
   const auto chosen = [&] {
     for (int n = 1; n <= threads_max; ++n)
       if (!cycle.measured(n)) return false;
     return true;
   };
-  for (int k = 0; k < 3 || (cycle.lanes() && k < 40 && !chosen()); ++k) {
+  for (int k = 0; k < 3 || (cycle.lanes() && k < 60 && !chosen()); ++k) {
     const ThreadCountScope scope(1 + k % threads_max);
     const AskedThreadsScope asked(true);  // chapter 09's adaptive team keeps the count
     stepper.step(state);
@@ -179,10 +205,11 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   l.packed.fill(0, l.packed.blocks.rows());
   std::ostringstream out;
   kernel_rows(l, mesh_name(scene), threads_max, repeat, out);
-  v_cycle_rows(stepper, threads_max, repeat, out);
+  step_rows(scene, threads_max, repeat, out);
   out << "\nMedians of " << repeat << " timings. The stepper's V-cycle runs this level "
       << stepper_layouts(cycle, threads_max)
-      << " (the shorter median of its first ten V-cycles on that team, the layouts in turn); "
+      << " (the shorter median of its first ten steps on that team, the layouts in turn, each "
+         "from its fill to its last V-cycle); "
          "filling it from the "
          "double blocks takes "
       << std::setprecision(1) << fill_us(cycle, l.part, repeat) << " us at 1 thread.\n";
@@ -206,7 +233,8 @@ std::string tables(const LessonRun& run) {
     out += "\n" + every_lane_table(scene, timings(scene, run.steps));
   return out + "\nA timing: " + std::to_string(kCalls) +
          " calls in one parallel region, on the level of the 3rd step (in the L2 or L3 cache "
-         "where it fits, else memory). " +
+         "where it fits, else memory); a step's: the median of whole steps, chapter 12's and one "
+         "chapter 14 stepper's in each layout (forced) in turn. " +
          measured_on() + ". Generated by `fem_lessons every-lane`.\n";
 }
 

@@ -37,7 +37,7 @@ class LaneMultigrid final : public ch08::PreconditionerPart {
     if (lanes_.lanes())
       out << "    finest level in pair lanes, "
           << (lanes_.layout() == Layout::padded ? "padded" : "packed")
-          << " (the faster of the two in its first V-cycles on each team size): "
+          << " (the faster of the two in its first steps on each team size): "
           << lanes_.with_fine_level([](const auto& fine) { return fine.blocks.bytes(); }) / 1024
           << " KiB\n";
   }

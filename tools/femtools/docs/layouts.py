@@ -1,15 +1,18 @@
 """Chapter 14's layouts against the lesson's own measurement: the stepper times its two layouts
-of a finest level (padded and packed pairs, the same bits) in its first V-cycles on each team
-size, in turn, and runs the one of the shorter median (lane_v_cycle.hpp). Whether the lesson's
-longer timings of whole V-cycles agree is a measurement, which can differ with the machine, the
-thread count and the sitting, so the lines that say it are generated from the rows of
-`fem_lessons every-lane` (docs/data/lessons/every-lane.json), between the markers
-every-lane-layouts of the chapter's README, by `fem-tools docs lessons`."""
+of a finest level (padded and packed pairs, the same bits) in its first steps on each team
+size, in turn, and runs the one of the shorter median (lane_v_cycle.hpp). Whether that choice
+gives the shorter whole step is a measurement, which can differ with the machine, the thread
+count and the sitting, so the lines that say it are generated from the rows of `fem_lessons
+every-lane` (docs/data/lessons/every-lane.json: whole steps in each layout, in turn), between the
+markers every-lane-layouts of the chapter's README, by `fem-tools docs lessons`."""
+import math
 import re
 
 MARKER = "every-lane-layouts"
 KERNELS = ("smoothing step", "residual")
-CYCLE = "one V-cycle"  # the row's name begins so; the stepper's own measure
+STEP = "one step"  # the row's name begins so: whole steps in each layout, what the choice is for
+ROUNDS = re.compile(r"(\d+) rounds; packed shorter in (\d+)")  # the step row's pairs
+SIGNIFICANCE = 0.05  # a sign test's two-sided p below it: the layouts', not the machine's
 LAYOUTS = {"padded": "pair lanes, us", "packed": "packed pairs, us"}
 
 
@@ -19,8 +22,8 @@ def cells(line):
 
 def levels(text):
     """Per finest level of the lesson's text: its mesh, the layout the stepper runs it in at each
-    thread count ({threads: layout}, from the table's caption) and {(kernel, threads): {layout:
-    microseconds}}."""
+    thread count ({threads: layout}, from the table's caption), {(kernel, threads): {layout:
+    microseconds}} and {threads: (rounds, rounds the packed step was the shorter)}."""
     found, lines, i = [], text.split("\n"), 0
     while i < len(lines):
         if not (lines[i].startswith("|") and "finest level" in lines[i]):
@@ -28,11 +31,13 @@ def levels(text):
             continue
         header = cells(lines[i])
         column = {name: header.index(title) for name, title in LAYOUTS.items() if title in header}
-        times, i = {}, i + 2
+        times, pairs, i = {}, {}, i + 2
         while i < len(lines) and lines[i].startswith("|"):
             row = cells(lines[i])
-            kind = CYCLE if row[0].startswith(CYCLE) else row[0]
-            if kind in KERNELS + (CYCLE,) and len(column) == len(LAYOUTS) and \
+            kind = STEP if row[0].startswith(STEP) else row[0]
+            if kind == STEP and (counted := ROUNDS.search(row[0])):
+                pairs[row[1]] = (int(counted.group(1)), int(counted.group(2)))
+            if kind in KERNELS + (STEP,) and len(column) == len(LAYOUTS) and \
                     all(row[k] for k in column.values()):
                 times[(kind, row[1])] = {name: float(row[k]) for name, k in column.items()}
             i += 1
@@ -40,7 +45,7 @@ def levels(text):
         clause = re.search(r"runs this level ([^(;]*)", caption)
         runs = dict((n, layout) for layout, n in
                     re.findall(r"(padded|packed) at (\d+) threads?", clause.group(1) if clause else ""))
-        found.append((header[0].split()[0], runs, times))
+        found.append((header[0].split()[0], runs, times, pairs))
     return found
 
 
@@ -50,20 +55,41 @@ def faster(times, threads, kinds):
     return winners.pop() if len(winners) == 1 else None
 
 
+def sign_test(rounds, wins):
+    """Two-sided p of `wins` in `rounds` if either layout were as likely the shorter."""
+    tail = min(wins, rounds - wins)
+    return min(1.0, 2 * sum(math.comb(rounds, k) for k in range(tail + 1)) / 2 ** rounds)
+
+
+def step_verdict(step, pairs):
+    """(the layout of the shorter step, or None where the rounds cannot tell, and the words)."""
+    best = min(step, key=step.get)
+    apart = f"{100 * (max(step.values()) / step[best] - 1):.0f}%"
+    if not pairs:
+        return best, f"{best} the shorter whole step by {apart}"
+    rounds, packed = pairs
+    if sign_test(rounds, packed) < SIGNIFICANCE:
+        shorter = "packed" if 2 * packed > rounds else "padded"
+        wins = packed if shorter == "packed" else rounds - packed
+        return shorter, f"{shorter} the shorter whole step in {wins} of {rounds} rounds ({apart} by the medians)"
+    return None, (f"the whole steps too close to tell (packed the shorter in {packed} of {rounds} rounds, "
+                  f"the medians {apart} apart)")
+
+
 def section(record, where=None):
     """One line per finest level: at each thread count the layout the stepper chose and the one
-    the lesson measured faster in a whole V-cycle, and in both kernels where they say otherwise
-    (where: named by the table's own caption)."""
+    of the shorter whole step in the lesson, where its rounds tell (a sign test), and the one
+    faster in both kernels where they say otherwise (where: named by the table's own caption)."""
     lines = []
-    for mesh, runs, times in levels(record.get("table", "")):
+    for mesh, runs, times, pairs in levels(record.get("table", "")):
         threads = sorted({n for _, n in times}, key=int)
         if not runs or not threads:
             continue
         said = []
         for n in threads:
-            best, chose = faster(times, n, (CYCLE,)), runs.get(n)
-            kernels = faster(times, n, KERNELS)
-            verdict = f"{best} faster in the lesson's V-cycle" if best else "no V-cycle row"
+            chose, kernels = runs.get(n), faster(times, n, KERNELS)
+            best, verdict = step_verdict(times[(STEP, n)], pairs.get(n)) if (STEP, n) in times \
+                else (None, "no whole-step row")
             mark = "" if not best or not chose or best == chose else " (**not** the stepper's)"
             if best and kernels != best:
                 verdict += f", {kernels} in both kernels" if kernels else ", neither in both kernels"
