@@ -101,6 +101,50 @@ TEST_CASE(
   }
 }
 
+// The trial's bookkeeping, whatever the timings say: a step that ran no V-cycle is not one of
+// its steps, the layouts alternate padded, packed, packed, padded, the eleventh step runs the
+// one recorded, another team size has its own trial, and force() acts from the next prepare.
+TEST_CASE(
+    "ch14: the layout trial counts the steps that ran a V-cycle, alternates, decides at the "
+    "eleventh on its own team size, and force() acts from the next prepare",
+    "[ch14]") {
+  const Scene scene = test::test_scene("cantilever");
+  ch12::HalfBytesStepper stepper(scene, {});
+  State state = rest_state(scene);
+  for (int k = 0; k < 3; ++k) stepper.step(state);
+  ch14::LaneVCycle lanes(stepper.preconditioner().v_cycle(), stepper.preconditioner().multigrid());
+  REQUIRE(lanes.lanes());
+  const Eigen::VectorXd r = Eigen::VectorXd::Ones(stepper.system_rhs().size());
+  Eigen::VectorXd s(r.size());
+  const ThreadCountScope one(1);
+  const auto steps = [&](int count, bool cycle) {
+    std::vector<ch14::Layout> ran;
+    ch09::run_parallel([&] {
+      for (int k = 0; k < count; ++k) {
+        lanes.prepare(stepper.system_matrix());
+        if (cycle) lanes.apply(r, s);
+        ch09::on_one_thread(true, [&] { ran.push_back(lanes.layout()); });
+      }
+    });
+    return ran;
+  };
+  steps(12, false);
+  CHECK(!lanes.measured(1));
+  const std::vector<ch14::Layout> ran = steps(11, true);
+  using L = ch14::Layout;
+  CHECK(std::vector<L>(ran.begin(), ran.begin() + 6) ==
+        std::vector<L>{L::padded, L::packed, L::packed, L::padded, L::padded, L::packed});
+  REQUIRE(lanes.measured(1));
+  CHECK(ran.back() == *lanes.measured(1));
+  CHECK(!lanes.measured(2));
+  const L other = *lanes.measured(1) == L::padded ? L::packed : L::padded;
+  lanes.force(other);
+  CHECK(lanes.layout() == *lanes.measured(1));
+  CHECK(steps(1, true).back() == other);
+  lanes.force(std::nullopt);
+  CHECK(steps(1, true).back() == *lanes.measured(1));
+}
+
 TEST_CASE("ch14: chapter 12's iterations at 1e-4, at most one more, and 1e-10 still reached",
           "[ch14]") {
   for (const double tolerance : {1e-4, 1e-10}) {
