@@ -80,17 +80,13 @@ const PlacedRun* placed(const std::vector<PlacedRun>& runs, const std::string& c
   return nullptr;
 }
 
-// The solve's bound at the iterations of the one timed (its work counted by the chapter's hook,
-// its waiting the placement's), and the bound of the parts the kernels make up.
-void set_solve(AloneRun& out, const ChapterInfo& chapter, const Stepper& stepper,
-               const Scene& scene, const Roofs& roofs, const PlacedRun& run) {
-  for (const PhasePoint& p : run.phases)
-    if (p.work.phase == "solve") out.waiting_s = p.waiting_s;
-  const WorkCounts counts{out.solve_iterations, run.executed};
-  for (const PhaseWork& w : course_of(chapter).work.count(stepper, scene, counts)) {
-    if (w.phase != "solve") continue;
-    out.solve_bound_s = bound_seconds(roofs, w) + out.waiting_s;
-    for (const PhaseWork& part : w.parts)
+// The placed solve's bound and waiting, and the bound of the parts the kernels make up.
+void set_solve(AloneRun& out, const Roofs& roofs, const PlacedRun& run) {
+  for (const PhasePoint& p : run.phases) {
+    if (p.work.phase != "solve") continue;
+    out.waiting_s = p.waiting_s;
+    out.solve_bound_s = p.bound_s;
+    for (const PhaseWork& part : p.work.parts)
       if (std::any_of(out.kernels.begin(), out.kernels.end(),
                       [&](const KernelAlone& k) { return k.part == part.phase; }))
         out.parts_bound_s += bound_seconds(roofs, part);
@@ -143,7 +139,7 @@ AloneRun measure_alone(const ChapterInfo& chapter, const Scene& scene, const Roo
   }
   set_calls(out.kernels, chapter, *stepper, scene, out.solve_iterations);
   for (const KernelAlone& k : out.kernels) out.alone_s += k.calls * k.seconds;
-  set_solve(out, chapter, *stepper, scene, roofs, run);
+  set_solve(out, roofs, run);
   return out;
 }
 

@@ -53,7 +53,7 @@ struct AloneRun {
   double solve_s = 0.0;           // the best solve of the steps timed in turn with the kernels
   double solve_iterations = 0.0;  // its PCG iterations, at which the kernels' calls are counted
   int solve_rounds = 0;           // the steps timed in turn with the kernels
-  double solve_bound_s = 0.0;     // its bound at those iterations
+  double solve_bound_s = 0.0;     // its bound
   double parts_bound_s = 0.0;     // the bound of the parts the kernels make up
   double alone_s = 0.0;           // the kernels alone: calls x seconds, summed
   double waiting_s = 0.0;         // the solve's waiting (in its bound)
