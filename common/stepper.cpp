@@ -52,7 +52,6 @@ class OneThreadStepper final : public Stepper {
   const StepProfile& profile() const override { return inner_->profile(); }
   bool uses_threads() const override { return false; }
   int threads_used() const override { return 1; }
-  int trial_steps() const override { return inner_->trial_steps(); }
   void set_external_forces(const std::vector<ExternalForce>& forces) override {
     inner_->set_external_forces(forces);
   }

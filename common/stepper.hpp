@@ -103,10 +103,6 @@ class Stepper {
   virtual bool uses_threads() const { return false; }
   // The threads the last step ran on, by the stepper's own record (0: it does not say).
   virtual int threads_used() const { return 0; }
-  // The steps in which it times its own choices on a new team size before it runs the one it
-  // chose (chapter 14's layouts), 0 for most: a measurement of its steady state steps these
-  // first, beyond its own warm-up (fem_bench, the roofline).
-  virtual int trial_steps() const { return 0; }
 
   // Replaces the sparse interaction forces from the next step on: the scene's own, or
   // the viewer's mouse spring. The storage is reused, so once it has held as many

@@ -22,7 +22,6 @@ struct RunningChapter {
   std::array<std::vector<double>, StepProfile::kPhaseCount> ms;
   std::vector<double> allocations, iterations;
   ChapterResult result;
-  int taken = 0;  // steps so far, its trial's included
 };
 
 // A run per chapter, and per thread count for a chapter that uses threads ("09_threads@2").
@@ -49,17 +48,16 @@ std::vector<RunningChapter> make_runs(const std::vector<const ChapterInfo*>& cha
   return runs;
 }
 
-// One step of a run; its profile becomes samples when the step is a measured one.
-void step(RunningChapter& run, bool measured) {
+// Step k of one run; its profile becomes samples when the step is a measured one.
+void step(RunningChapter& run, int k, bool measured) {
   set_threads(run.threads);  // the next parallel region's team; no cost between steps
   alloc::Scope counter;
   run.stepper->step(run.state);
   const long long allocs = counter.allocations();
-  ++run.taken;
   stop_if_interrupted();
   if (const char* why = divergence(run.state, run.stepper->profile()))
     throw std::runtime_error(run.result.chapter + ": the simulation diverged at step " +
-                             std::to_string(run.taken) + " (" + why + ")");
+                             std::to_string(k + 1) + " (" + why + ")");
   if (!measured) return;
   ChapterResult& r = run.result;
   const StepProfile& p = run.stepper->profile();
@@ -98,10 +96,6 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
                                         const std::vector<int>& thread_counts,
                                         const Schedule& schedule) {
   std::vector<RunningChapter> runs = make_runs(chapters, scene, solver, thread_counts);
-  for (RunningChapter& run : runs) {
-    run.result.trial_steps = run.stepper->trial_steps();
-    for (int k = 0; k < run.result.trial_steps; ++k) step(run, false);
-  }
   using Clock = std::chrono::steady_clock;
   for (int first = 0; first < schedule.total(); first += Schedule::turn) {
     const int last = std::min(schedule.total(), first + Schedule::turn);
@@ -109,7 +103,7 @@ std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& c
     for (RunningChapter& run : runs)
       for (int k = first; k < last; ++k) {
         const auto start = Clock::now();
-        step(run, schedule.measured(k));
+        step(run, k, schedule.measured(k));
         if (k > 0) seconds += std::chrono::duration<double>(Clock::now() - start).count();
       }
     if (first == 0 && last > 1)

@@ -28,16 +28,12 @@ struct ChapterResult {
   // The threads the measured steps ran on, by the stepper's own record (chapter 09's adaptive
   // team takes one thread while that is faster); 0 where the chapter does not say.
   int threads_fewest = 0, threads_most = 0;
-  // Steps the stepper spent timing its own choices before the schedule's (Stepper::trial_steps).
-  int trial_steps = 0;
 };
 
 // Runs the chapters interleaved, Schedule::turn steps of each in turn: when the machine's
 // speed drifts (a shared virtual machine, a CPU changing its clock), every chapter sees the
 // same drift, so their ratios hold even when the absolute times move. A chapter that uses threads
-// (09 on) runs once per thread count. A stepper that times its own choices in its first steps
-// (Stepper::trial_steps) takes those steps before the schedule, so that the schedule's warm-up
-// and measured steps run what it chose. Throws when a chapter's simulation diverges.
+// (09 on) runs once per thread count. Throws when a chapter's simulation diverges.
 std::vector<ChapterResult> run_chapters(const std::vector<const ChapterInfo*>& chapters,
                                         const Scene& scene, const SolverSettings& solver,
                                         const std::vector<int>& thread_counts,

@@ -65,9 +65,7 @@ void add_bench_options(ArgParser& args) {
               "comma-separated chapters, or 'all' (every chapter, variants included)", "all");
   args.option("steps", "N", "measured steps per chapter, > 0", "100");
   args.option("warmup", "N",
-              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers); a "
-              "stepper that times its own choices in its first steps (chapter 14) takes those "
-              "before",
+              "unmeasured steps first, >= 1 (the first step allocates the stepper's buffers)",
               "10");
   args.option("out", "DIR",
               "the run's folder: writes DIR/bench.json (default: a new folder "

@@ -70,7 +70,6 @@ Json chapter_json(const ChapterResult& r) {
   c["not_converged_steps"] = r.not_converged_steps;
   c["threads"] = r.threads;
   if (r.threads_most > 0) c["threads_ran"] = {r.threads_fewest, r.threads_most};
-  if (r.trial_steps > 0) c["trial_steps"] = r.trial_steps;
   return c;
 }
 

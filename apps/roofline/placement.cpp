@@ -67,11 +67,10 @@ PhasePoint place_phase(const PhaseWork& w, const PhaseRecord& record, const Roof
   return point;
 }
 
-// The stepper at the roofs' thread count: its trial and `warmup` steps, then `steps` measured.
+// The stepper at the roofs' thread count: `warmup` steps, then `steps` measured.
 PlacedRun measure(const ChapterInfo& chapter, Stepper& stepper, const Scene& scene,
                   const Roofs& roofs, int warmup, int steps) {
   const ThreadCountScope team(roofs.threads);
-  warmup += stepper.trial_steps();  // its own trial first, as fem_bench runs it
   PlacedRun run;
   run.mesh = mesh_name(scene);
   run.chapter = chapter.id;

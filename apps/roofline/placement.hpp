@@ -38,8 +38,7 @@ struct PlacedRun {
 };
 
 // `chapter` on `scene` under each of `roofs` (one per thread count; a chapter that does not
-// use threads only under the one-thread roofs): its own trial (Stepper::trial_steps) and
-// `warmup` steps, then `steps` measured, medians
+// use threads only under the one-thread roofs): `warmup` steps, then `steps` measured, medians
 // per phase, its work counted by the chapter's own hook (CourseChapter::work; a chapter without
 // one is measured and not counted). A fresh stepper at each count, as fem_bench's runs.
 std::vector<PlacedRun> place_chapter(const ChapterInfo& chapter, const Scene& scene,

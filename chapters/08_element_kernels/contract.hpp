@@ -15,7 +15,7 @@
 // | Preconditioner | (const PartSetup&, const Params&) | a PreconditionerPart: prepare(A),      |
 // |                |                                | apply(r, s) [, block_diagonal(),          |
 // |                |                                | apply_rows(first, last, r, s),            |
-// |                |                                | set_constraints(c), trial_steps()]        |
+// |                |                                | set_constraints(c)]                       |
 // | Solver         | (const PartSetup&, const Params&) | solve(system, product, preconditioner, |
 // |                |                                | settings), set_constraints(c)             |
 //
@@ -126,9 +126,6 @@ class PreconditionerPart {
   // prepare on. A part built only from each step's A needs nothing; one that keeps what it set
   // up from the constraints (a multigrid's coarse space) sets it up again.
   virtual void set_constraints(const std::vector<NodeConstraint>& constraints);
-  // The steps its first prepares on a new team size spend timing its own choices (chapter 14's
-  // layouts), which a measurement of the step's steady state must run first: Stepper's.
-  virtual int trial_steps() const { return 0; }
 };
 
 // The roles, in the order StepOf builds them: the one list that the phase owners, the walk over

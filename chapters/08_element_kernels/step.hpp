@@ -118,7 +118,6 @@ class StepOf<Recipe, true> final : public Stepper {
   const StepProfile& profile() const override { return profile_; }
   bool uses_threads() const override { return Team::kThreads; }
   int threads_used() const override { return team_.threads(); }
-  int trial_steps() const override { return preconditioner_.trial_steps(); }
   void set_external_forces(const std::vector<ExternalForce>& forces) override {
     Stepper::set_external_forces(order_.inward(forces));
     order_.outward(f_ext_);

@@ -52,9 +52,6 @@ class LaneVCycle {
   bool lanes() const { return lanes_; }
   // The layout the last prepare filled, which apply runs.
   Layout layout() const { return current_; }
-  // The steps of a team size's trial before it runs the layout it measured faster (0: none,
-  // forced or no lanes).
-  int trial_steps() const { return lanes_ && !forced_ ? 2 * kTrials : 0; }
   // The layout measured faster on a team of `threads`, once its trial is over.
   std::optional<Layout> measured(int threads) const;
   // From the next prepare on, run `layout` on every team (std::nullopt: the measured one), as

@@ -27,7 +27,6 @@ class LaneMultigrid final : public ch08::PreconditionerPart {
   void set_constraints(const std::vector<NodeConstraint>& constraints) override {
     reduced_.set_constraints(constraints);
   }
-  int trial_steps() const override { return lanes_.trial_steps(); }
   LaneVCycle& lane_v_cycle() { return lanes_; }
   const LaneVCycle& lane_v_cycle() const { return lanes_; }
   ch12::ReducedMultigrid<float>& reduced() { return reduced_; }

@@ -17,7 +17,6 @@
 #include "chapters/12_half_the_bytes/work.hpp"
 #include "chapters/14_every_lane/stepper.hpp"
 #include "chapters/14_every_lane/work.hpp"
-#include "chapters/registry.hpp"
 #include "common/threads.hpp"
 #include "support.hpp"
 
@@ -139,25 +138,11 @@ TEST_CASE(
   CHECK(ran.back() == *lanes.measured(1));
   CHECK(!lanes.measured(2));
   const L other = *lanes.measured(1) == L::padded ? L::packed : L::padded;
-  CHECK(lanes.trial_steps() == 10);
   lanes.force(other);
-  CHECK(lanes.trial_steps() == 0);  // forced: no trial to wait for
   CHECK(lanes.layout() == *lanes.measured(1));
   CHECK(steps(1, true).back() == other);
   lanes.force(std::nullopt);
   CHECK(steps(1, true).back() == *lanes.measured(1));
-}
-
-// What a benchmark steps before it measures (fem_bench, the roofline): chapter 14's stepper
-// says its trial, through the recipe and the registry; a stepper that times nothing, 0.
-TEST_CASE("ch14: the stepper says the steps of its layout trial, the others none", "[ch14]") {
-  const Scene scene = test::test_scene("cantilever");
-  CHECK(make_stepper("14", scene)->trial_steps() == 10);
-  CHECK(make_stepper("12", scene)->trial_steps() == 0);
-  CHECK(make_stepper("07", scene)->trial_steps() == 0);  // on one thread: passed on, 0
-  ch14::EveryLaneStepper stepper(scene, {});
-  stepper.preconditioner().lane_v_cycle().force(ch14::Layout::packed);
-  CHECK(stepper.trial_steps() == 0);
 }
 
 TEST_CASE("ch14: chapter 12's iterations at 1e-4, at most one more, and 1e-10 still reached",
