@@ -50,15 +50,18 @@ struct AloneRun {
   std::string chapter, mesh;
   int threads = 1;
   std::vector<KernelAlone> kernels;
-  double solve_s = 0.0;        // the solve's measured median (the placement's)
-  double solve_bound_s = 0.0;  // its bound
-  double parts_bound_s = 0.0;  // the bound of the parts the kernels make up
-  double alone_s = 0.0;        // the kernels alone: calls x seconds, summed
-  double waiting_s = 0.0;      // the solve's waiting (in its bound)
+  double solve_s = 0.0;           // the best solve of the steps timed in turn with the kernels
+  double solve_iterations = 0.0;  // its PCG iterations, at which the kernels' calls are counted
+  int solve_rounds = 0;           // the steps timed in turn with the kernels
+  double solve_bound_s = 0.0;     // its bound at those iterations
+  double parts_bound_s = 0.0;     // the bound of the parts the kernels make up
+  double alone_s = 0.0;           // the kernels alone: calls x seconds, summed
+  double waiting_s = 0.0;         // the solve's waiting (in its bound)
 };
 
 // Each of `chapters` placed in `runs` on `scene`, at each thread count of `roofs`: a fresh
-// stepper, a few steps, then its solve's kernels alone under those roofs.
+// stepper, a few steps in, then its solve and its kernels alone timed in turn
+// (the best of each), under those roofs and against the placement's bound.
 std::vector<AloneRun> kernels_alone(const std::vector<const ChapterInfo*>& chapters,
                                     const Scene& scene, const std::vector<Roofs>& roofs,
                                     const std::vector<PlacedRun>& runs);

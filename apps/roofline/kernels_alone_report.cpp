@@ -57,10 +57,11 @@ std::string kernels_alone_table(const std::vector<AloneRun>& runs) {
         << ms(between(r)) << " | " << ms(r.waiting_s) << " |\n";
   out << "\nKernels alone: each of the solve's dominant kernels called again and again on the "
          "same data, the best of repeated timings, each call ending at its loop's barrier as in "
-         "the solve. In the core: the kernels alone beyond their own bound (instructions, "
-         "indexing, the latency of small blocks). Between the kernels: the solve beyond its "
-         "kernels alone and the bound of the parts no kernel here stands for (short loops, the "
-         "coarse levels, data evicted between kernels, waiting).\n";
+         "the solve; the solve: the best of as many steps taken in turn with those timings, the "
+         "kernels' calls counted at its iterations. In the core: the kernels alone beyond their "
+         "own bound (instructions, indexing, the latency of small blocks). Between the kernels: "
+         "the solve beyond its kernels alone and the bound of what no kernel here stands for "
+         "(short loops, data evicted between kernels, waiting).\n";
   return out.str();
 }
 
@@ -85,6 +86,8 @@ std::string with_kernels_alone(const std::string& data, const std::vector<AloneR
                        {"mesh", r.mesh},
                        {"threads", r.threads},
                        {"solve_s", r.solve_s},
+                       {"solve_iterations", r.solve_iterations},
+                       {"solve_rounds", r.solve_rounds},
                        {"solve_bound_s", r.solve_bound_s},
                        {"parts_bound_s", r.parts_bound_s},
                        {"alone_s", r.alone_s},

@@ -113,6 +113,21 @@ std::vector<PartKernel> solve_kernels(StepOf<Recipe>& stepper, const Scene& scen
   std::vector<PartKernel> kernels = solver_kernels(stepper.solver(), in);
   for (PartKernel& k : preconditioner_kernels(stepper.preconditioner(), in))
     kernels.push_back(std::move(k));
+  if (kernels.empty()) return kernels;
+  // The solve's set-up, once a step: the product's and the preconditioner's numbers from this
+  // step's A (copies into their layouts, a multigrid's factorize), as the solver's team runs it.
+  PartKernel set_up;
+  set_up.name = "prepare: the product's and the preconditioner's numbers from A";
+  set_up.part = "prepare";
+  const std::vector<PhaseWork> counted = count_work(stepper, scene, WorkCounts{iterations, {}});
+  for (const PhaseWork& p : counted.back().parts)  // the solve's parts (a temporary's would dangle)
+    if (p.phase == set_up.part) set_up.work = p;
+  set_up.calls = 1.0;
+  set_up.run = [&stepper] {
+    stepper.product().prepare(stepper.system_matrix());
+    stepper.preconditioner().prepare(stepper.system_matrix());
+  };
+  kernels.push_back(std::move(set_up));
   return kernels;
 }
 

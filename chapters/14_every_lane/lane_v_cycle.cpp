@@ -18,13 +18,6 @@ int team_size() {
 #endif
 }
 
-// Each thread fills the row blocks it smooths (the same static share of the same parts).
-template <class Lanes>
-void fill(Lanes& fine) {
-  ch09::for_parts(source_level(fine).rows.part, true,
-                  [&](int first, int last) { fine.fill(first, last); });
-}
-
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -51,16 +44,18 @@ std::optional<Layout> LaneVCycle::measured(int threads) const {
   return Layout(m);
 }
 
-// The trial's order: padded, packed, packed, padded, padded, packed, ... (each pair of turns
-// reversed), so that a drift of the machine's speed over the trial weighs on both alike.
-Layout LaneVCycle::Trial::next() const {
-  return ((steps + 1) / 2) % 2 == 0 ? Layout::padded : Layout::packed;
+const LaneVCycle::Seconds& LaneVCycle::trial_seconds(int threads) const {
+  return trials_[std::clamp(threads, 1, kTeams)];
 }
 
-// The layout whose median step was the shorter: a median, not a mean, because one step
-// disturbed by the machine (or the first, with data still in the other layout's place) would
-// move a mean by more than the layouts differ.
-Layout LaneVCycle::Trial::faster() {
+// The trial's order: padded, packed, packed, padded, padded, packed, ... (each pair of turns
+// reversed), so that a drift of the machine's speed over the trial weighs on both alike.
+Layout LaneVCycle::turn(int k) { return ((k + 1) / 2) % 2 == 0 ? Layout::padded : Layout::packed; }
+
+// The layout whose median time was the shorter: a median, not a mean, because one turn
+// disturbed by the machine (or the first of each, whose fill touches its pages for the first
+// time) would move a mean by more than the layouts differ.
+Layout LaneVCycle::faster(Seconds seconds) {
   const auto median = [](double* first) {
     std::nth_element(first, first + kTrials / 2, first + kTrials);
     return first[kTrials / 2];
@@ -69,40 +64,45 @@ Layout LaneVCycle::Trial::faster() {
                                                                    : Layout::padded;
 }
 
-void LaneVCycle::Trial::record(Layout layout, double time) {
-  seconds[(layout == Layout::packed ? kTrials : 0) + steps / 2] = time;
-  ++steps;
+// Each thread fills the row blocks it smooths (the same static share of the same parts).
+void LaneVCycle::fill(Layout layout) {
+  ch09::on_one_thread(true, [&] { current_ = layout; });
+  with_fine_level([&](auto& fine) {
+    ch09::for_parts(source_level(fine).rows.part, true,
+                    [&](int first, int last) { fine.fill(first, last); });
+  });
 }
 
-// By one thread, at the next prepare: the step's end is its last V-cycle's, since only then
-// is it known to be the last. A step whose solve ran no V-cycle (a guess already converged)
-// is not a trial's.
-void LaneVCycle::end_trial_step() {
-  if (trial_team_ == 0 || ended_ <= started_) return;
-  Trial& trial = trials_[trial_team_];
-  trial.record(current_, ended_ - started_);
-  if (trial.steps == 2 * kTrials) measured_[trial_team_] = static_cast<signed char>(trial.faster());
+// Each turn: one layout filled from this step's blocks and three V-cycles run from it, the
+// time from the fill's start to the last cycle's end (the barrier in on_one_thread). The
+// cycles' input is a fixed vector (their cost does not depend on its values); apply
+// overwrites r_ and s_ before they are read again.
+void LaneVCycle::trial(int team) {
+  Seconds& seconds = trials_[team];
+  ch09::on_one_thread(true, [&] { r_.setOnes(); });
+  for (int k = 0; k < 2 * kTrials; ++k) {
+    ch09::on_one_thread(true, [&] { started_ = now_seconds(); });
+    fill(turn(k));
+    // Not through multigrid_.apply, which counts its cycles for the refresh rule: the trial's
+    // would change when the hierarchy is rebuilt, so the state would depend on the trial.
+    for (int c = 0; c < kCycles; ++c)
+      with_fine_level(
+          [&](auto& fine) { ch10::v_cycle(fine, reduced_.coarse_levels(), 0, r_, s_, true); });
+    ch09::on_one_thread(true, [&] {
+      seconds[(current_ == Layout::packed ? kTrials : 0) + k / 2] = now_seconds() - started_;
+    });
+  }
+  ch09::on_one_thread(true, [&] { measured_[team] = static_cast<signed char>(faster(seconds)); });
 }
 
 void LaneVCycle::prepare(const ch07::BlockSparseMatrix& A) {
   reduced_.prepare(A);
   if (!lanes_) return;
   const int team = std::clamp(team_size(), 1, kTeams);
-  ch09::on_one_thread(true, [&] {
-    end_trial_step();
-    const bool trial = !forced_ && measured_[team] < 0;
-    trial_team_ = trial ? team : 0;
-    current_ = forced_ ? *forced_ : trial ? trials_[team].next() : Layout(measured_[team]);
-    started_ = ended_ = now_seconds();
-  });
-  if (current_ == Layout::padded)
-    fill(padded_);
-  else
-    fill(packed_);
+  if (!forced_ && measured_[team] < 0) trial(team);
+  fill(forced_ ? *forced_ : Layout(measured_[team]));
 }
 
-// A V-cycle of a trial's step ends after every thread's share (the last convert_rows ends in
-// the team's barrier); one thread reads the clock.
 void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   if (!lanes_) {
     reduced_.apply(r, s);
@@ -112,7 +112,6 @@ void LaneVCycle::apply(const Eigen::VectorXd& r, Eigen::VectorXd& s) {
   ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(r, r_, first, last); });
   with_fine_level([&](auto& fine) { multigrid_.apply(fine, reduced_.coarse_levels(), r_, s_); });
   ch09::for_parts(part, true, [&](int first, int last) { ch12::convert_rows(s_, s, first, last); });
-  if (trial_team_ != 0) ch09::on_one_thread(true, [&] { ended_ = now_seconds(); });
 }
 
 }  // namespace fem::ch14

@@ -10,10 +10,11 @@
 // book's recordings found the padded faster on one machine and the packed on another for the
 // same level, and the two orders swapped between one thread and two. The layouts compute the
 // same bits (fine_smoothing_rows.hpp spells out the one multiply-add), so the stepper times
-// them where they run: its first ten steps on each team size alternate the two (five each),
-// each timed from its fill to its last V-cycle, so the PCG's product and updates between the
-// cycles count (they run in the caches the layout leaves them), and it keeps the one of the
-// shorter median. The state does not depend on the choice, only the time.
+// them where they run: the first prepare on each team size fills each layout five times in
+// turn and runs three V-cycles from it, timed from the fill to the last cycle's end, and keeps
+// the one of the shorter median. The trial runs on that step's own matrix and spends no step
+// of the simulation: the first step on a team is longer, and every later one is the same step
+// it would be in the other layout. The state does not depend on the choice, only the time.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,8 +43,8 @@ class LaneVCycle {
              std::optional<Layout> forced = std::nullopt);
 
   // Chapter 12's prepare (chapter 10's factorize, its numbers into float), then the finest
-  // level's double blocks into the layout this team size runs (while it has not chosen: the
-  // trial's next, and the last step's trial time recorded). By every thread, once a step.
+  // level's double blocks into the layout this team size runs (on a team size not seen
+  // before, after the trial that chooses it). By every thread, once a step.
   void prepare(const ch07::BlockSparseMatrix& A);
   // s = M r: one float V-cycle from the lanes' finest level. By every thread.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& s);
@@ -54,6 +55,10 @@ class LaneVCycle {
   Layout layout() const { return current_; }
   // The layout measured faster on a team of `threads`, once its trial is over.
   std::optional<Layout> measured(int threads) const;
+  // That trial's times in seconds, padded's then packed's (zeros before it ran).
+  static constexpr int kTrials = 5;                 // fills timed in each layout
+  using Seconds = std::array<double, 2 * kTrials>;  // padded's, then packed's
+  const Seconds& trial_seconds(int threads) const;
   // From the next prepare on, run `layout` on every team (std::nullopt: the measured one), as
   // `forced` does; the lesson's whole steps in each layout. Between steps, not in a V-cycle.
   void force(std::optional<Layout> layout) { forced_ = layout; }
@@ -68,28 +73,22 @@ class LaneVCycle {
   }
 
  private:
-  static constexpr int kTeams = 64;  // team sizes remembered (a larger one shares the last)
-  static constexpr int kTrials = 5;  // steps timed in each layout
-  // One team size's trial: the seconds of each step's fill and solve, padded's then packed's.
-  struct Trial {
-    int steps = 0;
-    std::array<double, 2 * kTrials> seconds{};
-    Layout next() const;
-    void record(Layout layout, double time);
-    Layout faster();  // reorders `seconds`
-  };
-  void end_trial_step();  // the last step's time into its team's trial, once it has one
+  static constexpr int kTeams = 64;       // team sizes remembered (a larger one shares the last)
+  static constexpr int kCycles = 3;       // V-cycles timed after each fill
+  static Layout turn(int k);              // the trial's k-th layout
+  static Layout faster(Seconds seconds);  // the one of the shorter median
+  // By every thread: the trial on a team of `team`, and the layout it chose filled.
+  void trial(int team);
+  void fill(Layout layout);  // by every thread, into current_
 
   ch12::ReducedVCycle<float>& reduced_;
   ch10::Multigrid& multigrid_;
   bool lanes_;
   std::optional<Layout> forced_;
   std::array<signed char, kTeams + 1> measured_;  // per team size: -1, or the faster Layout
-  std::array<Trial, kTeams + 1> trials_;
+  std::array<Seconds, kTeams + 1> trials_{};
   Layout current_;
-  int trial_team_ = 0;    // the team size the last prepare's step is a trial of, or 0
-  double started_ = 0.0;  // that step's fill began, by one thread's clock
-  double ended_ = 0.0;    // its last V-cycle so far ended
+  double started_ = 0.0;  // the trial's turn began, by one thread's clock (shared by the team)
   PaddedLanes padded_;
   PackedLanes packed_;
   Eigen::VectorXf r_, s_;  // the PCG's residual and its preconditioned residual in float

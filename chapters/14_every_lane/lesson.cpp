@@ -181,7 +181,7 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   const int threads_max = std::min(2, max_threads());
   LaneVCycle& cycle = stepper.preconditioner().lane_v_cycle();
   // Steps on each team size in turn (at least three), until the stepper has timed its layouts
-  // on each: ten steps on each, chosen at the eleventh.
+  // on each: in its first prepare on each.
   const auto chosen = [&] {
     for (int n = 1; n <= threads_max; ++n)
       if (!cycle.measured(n)) return false;
@@ -208,10 +208,8 @@ std::string every_lane_table(const Scene& scene, int repeat) {
   step_rows(scene, threads_max, repeat, out);
   out << "\nMedians of " << repeat << " timings. The stepper's V-cycle runs this level "
       << stepper_layouts(cycle, threads_max)
-      << " (the shorter median of its first ten steps on that team, the layouts in turn, each "
-         "from its fill to its last V-cycle); "
-         "filling it from the "
-         "double blocks takes "
+      << " (the shorter median of five fills and cycles of each, in its first step on that "
+         "team); filling it from the double blocks takes "
       << std::setprecision(1) << fill_us(cycle, l.part, repeat) << " us at 1 thread.\n";
   return out.str();
 }

@@ -50,9 +50,8 @@ Applied apply_both(const Scene& scene, int threads, std::optional<ch14::Layout> 
   Eigen::VectorXd r(n);
   for (Eigen::Index k = 0; k < n; ++k) r[k] = uniform(rng);
   Applied out{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
-  // Measured: the trial's ten steps (a prepare and two V-cycles each), the two layouts in
-  // turn, then one in the chosen.
-  std::vector<Eigen::VectorXd> cycles(layout ? 2 : 22, Eigen::VectorXd::Zero(n));
+  // Measured: the trial in the first prepare, then prepares in the chosen layout.
+  std::vector<Eigen::VectorXd> cycles(layout ? 2 : 6, Eigen::VectorXd::Zero(n));
   ch09::run_parallel([&] {
     for (std::size_t k = 0; k < cycles.size(); k += 2) {
       lanes.prepare(stepper.system_matrix());
@@ -101,48 +100,67 @@ TEST_CASE(
   }
 }
 
-// The trial's bookkeeping, whatever the timings say: a step that ran no V-cycle is not one of
-// its steps, the layouts alternate padded, packed, packed, padded, the eleventh step runs the
-// one recorded, another team size has its own trial, and force() acts from the next prepare.
+// The trial's bookkeeping, whatever the timings say: the first prepare on a team size times
+// both layouts (five fills of each) and runs the faster from that prepare on, another team
+// size has its own trial, a forced layout runs no trial, and force() acts from the next prepare.
 TEST_CASE(
-    "ch14: the layout trial counts the steps that ran a V-cycle, alternates, decides at the "
-    "eleventh on its own team size, and force() acts from the next prepare",
+    "ch14: the layout trial runs in the first prepare on each team size, times five fills of "
+    "each layout, and force() acts from the next prepare",
     "[ch14]") {
   const Scene scene = test::test_scene("cantilever");
   ch12::HalfBytesStepper stepper(scene, {});
   State state = rest_state(scene);
   for (int k = 0; k < 3; ++k) stepper.step(state);
-  ch14::LaneVCycle lanes(stepper.preconditioner().v_cycle(), stepper.preconditioner().multigrid());
+  const auto make = [&](std::optional<ch14::Layout> forced) {
+    return ch14::LaneVCycle(stepper.preconditioner().v_cycle(),
+                            stepper.preconditioner().multigrid(), forced);
+  };
+  ch14::LaneVCycle lanes = make(std::nullopt);
   REQUIRE(lanes.lanes());
   const Eigen::VectorXd r = Eigen::VectorXd::Ones(stepper.system_rhs().size());
   Eigen::VectorXd s(r.size());
-  const ThreadCountScope one(1);
-  const auto steps = [&](int count, bool cycle) {
-    std::vector<ch14::Layout> ran;
+  const auto steps = [&](ch14::LaneVCycle& cycle, int threads) {
+    const ThreadCountScope team(threads);
+    ch14::Layout ran{};
     ch09::run_parallel([&] {
-      for (int k = 0; k < count; ++k) {
-        lanes.prepare(stepper.system_matrix());
-        if (cycle) lanes.apply(r, s);
-        ch09::on_one_thread(true, [&] { ran.push_back(lanes.layout()); });
-      }
+      cycle.prepare(stepper.system_matrix());
+      cycle.apply(r, s);
+      ch09::on_one_thread(true, [&] { ran = cycle.layout(); });
     });
     return ran;
   };
-  steps(12, false);
+  const auto timed = [&](const ch14::LaneVCycle& cycle, int threads) {
+    const ch14::LaneVCycle::Seconds& seconds = cycle.trial_seconds(threads);
+    return std::all_of(seconds.begin(), seconds.end(), [](double t) { return t > 0.0; });
+  };
   CHECK(!lanes.measured(1));
-  const std::vector<ch14::Layout> ran = steps(11, true);
-  using L = ch14::Layout;
-  CHECK(std::vector<L>(ran.begin(), ran.begin() + 6) ==
-        std::vector<L>{L::padded, L::packed, L::packed, L::padded, L::padded, L::packed});
+  CHECK(!timed(lanes, 1));
+  const ch14::Layout first = steps(lanes, 1);
   REQUIRE(lanes.measured(1));
-  CHECK(ran.back() == *lanes.measured(1));
+  CHECK(first == *lanes.measured(1));
+  CHECK(timed(lanes, 1));
   CHECK(!lanes.measured(2));
-  const L other = *lanes.measured(1) == L::padded ? L::packed : L::padded;
+  const ch14::LaneVCycle::Seconds once = lanes.trial_seconds(1);
+  CHECK(steps(lanes, 1) == first);
+  CHECK(lanes.trial_seconds(1) == once);  // timed once per team size
+  using L = ch14::Layout;
+  const L other = first == L::padded ? L::packed : L::padded;
   lanes.force(other);
-  CHECK(lanes.layout() == *lanes.measured(1));
-  CHECK(steps(1, true).back() == other);
+  CHECK(lanes.layout() == first);
+  CHECK(steps(lanes, 1) == other);
   lanes.force(std::nullopt);
-  CHECK(steps(1, true).back() == *lanes.measured(1));
+  CHECK(steps(lanes, 1) == first);
+  if (max_threads() >= 2) {
+    const L two = steps(lanes, 2);
+    REQUIRE(lanes.measured(2));
+    CHECK(two == *lanes.measured(2));
+    CHECK(timed(lanes, 2));
+    CHECK(lanes.trial_seconds(1) == once);
+  }
+  ch14::LaneVCycle forced = make(L::packed);
+  CHECK(steps(forced, 1) == L::packed);
+  CHECK(!forced.measured(1));
+  CHECK(!timed(forced, 1));
 }
 
 TEST_CASE("ch14: chapter 12's iterations at 1e-4, at most one more, and 1e-10 still reached",

@@ -12,7 +12,7 @@ HEADER = ("| beam_50k.msh (41283 rows), finest level, float | threads | chapter 
 def lesson(rows, runs="packed at 1 thread, packed at 2 threads"):
     body = "".join(f"| {k} | {n} | 9 | {padded} | x1 | {packed} | x1 |\n" for k, n, padded, packed in rows)
     return {"table": HEADER + body + f"\nMedians. The stepper's V-cycle runs this level {runs} "
-                                      "(the shorter median of its first ten steps on that team).\n"}
+                                      "(the shorter median of five fills of each, in its first step on that team).\n"}
 
 
 def rows(n, padded, packed, kernels=None, packed_shorter=None):

@@ -1,6 +1,6 @@
 """Chapter 14's layouts against the lesson's own measurement: the stepper times its two layouts
-of a finest level (padded and packed pairs, the same bits) in its first steps on each team
-size, in turn, and runs the one of the shorter median (lane_v_cycle.hpp). Whether that choice
+of a finest level (padded and packed pairs, the same bits) in its first prepare on each
+team size, in turn, and runs the one of the shorter median (lane_v_cycle.hpp). Whether that choice
 gives the shorter whole step is a measurement, which can differ with the machine, the thread
 count and the sitting, so the lines that say it are generated from the rows of `fem_lessons
 every-lane` (docs/data/lessons/every-lane.json: whole steps in each layout, in turn), between the
