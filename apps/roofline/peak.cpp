@@ -36,7 +36,7 @@ T fma_chains(Chains<T>& chains) {
 }
 
 template <class T>
-double peak_flops(int threads, double seconds) {
+double peak_flops(int threads, double seconds, int timings) {
   using Packet = typename Eigen::internal::packet_traits<T>::type;
   constexpr int lanes = Eigen::internal::packet_traits<T>::size;
   // 2 flops per lane per multiply-add.
@@ -48,15 +48,17 @@ double peak_flops(int threads, double seconds) {
         for (Packet& p : chains.acc) p = Eigen::internal::pset1<Packet>(T(1));
         return chains;
       },
-      [](Chains<T>& chains) { return double(fma_chains<T>(chains)); });
+      [](Chains<T>& chains) { return double(fma_chains<T>(chains)); }, timings);
 }
 
 }  // namespace
 
-double peak_flops_double(int threads, double seconds) {
-  return peak_flops<double>(threads, seconds);
+double peak_flops_double(int threads, double seconds, int timings) {
+  return peak_flops<double>(threads, seconds, timings);
 }
-double peak_flops_float(int threads, double seconds) { return peak_flops<float>(threads, seconds); }
+double peak_flops_float(int threads, double seconds, int timings) {
+  return peak_flops<float>(threads, seconds, timings);
+}
 
 int double_lanes() { return Eigen::internal::packet_traits<double>::size; }
 int float_lanes() { return Eigen::internal::packet_traits<float>::size; }

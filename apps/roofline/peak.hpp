@@ -6,12 +6,14 @@
 // one core, or only without the wide vector units busy; the measured rate is what a loop gets.
 #pragma once
 
+#include "apps/roofline/best_rate.hpp"  // kRoofTimings
+
 namespace fem::roofline {
 
 // Flops per second (a multiply-add counts as 2 flops) of `threads` threads, each running the
-// kernel for about `seconds` in all: the best timing, as for the bandwidths.
-double peak_flops_double(int threads, double seconds);
-double peak_flops_float(int threads, double seconds);
+// kernel for about `seconds` in all: the best of `timings` timings, as for the bandwidths.
+double peak_flops_double(int threads, double seconds, int timings = kRoofTimings);
+double peak_flops_float(int threads, double seconds, int timings = kRoofTimings);
 
 // The lanes of one packet: what "the vector width the build targets" is, in numbers.
 int double_lanes();
