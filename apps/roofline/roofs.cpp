@@ -7,6 +7,25 @@
 
 namespace fem::roofline {
 
+namespace {
+
+// The double peak and its check sampled as the levels are, in rounds: one of each, back to
+// back. Timed one after the other, on the 2-vCPU Xeon ours read 84 GFlop/s at two threads (one
+// thread's rate: the two vCPUs on one core) and likwid-bench's, run after it, 140.
+void measure_peak(Roofs& roofs, int threads, double seconds, bool likwid) {
+  const double round_s =
+      likwid ? std::max(seconds / kRoofRounds, kLikwidRunSeconds) : seconds / kRoofRounds;
+  for (int round = 0; round < kRoofRounds; ++round) {
+    const double peak = peak_flops_double(threads, round_s, likwid ? 1 : kRoofTimings);
+    roofs.peak_double = std::max(roofs.peak_double, peak);
+    if (!likwid) continue;
+    const LikwidRate r = likwid_bench(LikwidKernel::peak, 16 << 10, threads, round_s, peak, 1);
+    if (r.rate > roofs.likwid_peak.rate || roofs.likwid_peak.kernel.empty()) roofs.likwid_peak = r;
+  }
+}
+
+}  // namespace
+
 Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double seconds,
                     bool likwid) {
   Roofs roofs;
@@ -51,18 +70,7 @@ Roofs measure_roofs(const std::vector<CacheLevel>& caches, int threads, double s
     roof.triad = triad_bandwidth(bytes / 3, threads, seconds);
     roofs.levels.push_back(roof);
   }
-  // The peak and its check sampled as the levels are, in rounds: one of each, back to back.
-  // Timed one after the other, on the 2-vCPU Xeon ours read 84 GFlop/s at two threads (one
-  // thread's rate: the two vCPUs on one core) and likwid-bench's, run after it, 140.
-  const double round_s =
-      likwid ? std::max(seconds / kRoofRounds, kLikwidRunSeconds) : seconds / kRoofRounds;
-  for (int round = 0; round < kRoofRounds; ++round) {
-    const double peak = peak_flops_double(threads, round_s, likwid ? 1 : kRoofTimings);
-    roofs.peak_double = std::max(roofs.peak_double, peak);
-    if (!likwid) continue;
-    const LikwidRate r = likwid_bench(LikwidKernel::peak, 16 << 10, threads, round_s, peak, 1);
-    if (r.rate > roofs.likwid_peak.rate || roofs.likwid_peak.kernel.empty()) roofs.likwid_peak = r;
-  }
+  measure_peak(roofs, threads, seconds, likwid);
   roofs.peak_float = peak_flops_float(threads, seconds);
   roofs.clock = measured_clock();
   roofs.barrier_s = barrier_seconds(threads);
